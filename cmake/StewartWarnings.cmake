@@ -1,0 +1,9 @@
+# Warnings as errors on our own code only (generated LCM headers and system
+# headers are included as SYSTEM so their warnings never fail the build).
+function(stewart_target_warnings target)
+  target_compile_options(${target} PRIVATE -Wall -Wextra -Wpedantic -Wshadow
+                                           -Wnon-virtual-dtor -Werror)
+endfunction()
+
+# Release builds keep assertions off but stay debuggable.
+string(APPEND CMAKE_CXX_FLAGS_RELEASE " -g1")

@@ -1,0 +1,21 @@
+#pragma once
+#include <string>
+
+#include "stewart/config/config_node.h"
+
+namespace stewart {
+
+/// `plant_sim`: the simulator's integrator and modes.
+struct PlantSimConfig {
+  double rel_tol = 1e-8;
+  double abs_tol = 1e-10;
+  double command_timeout_s = 0.05;
+  std::string timeout_fallback = "off";
+  double lockstep_timeout_s = 5.0;
+  Vector6d initial_pose = Vector6d::Zero();
+  Vector6d initial_velocity = Vector6d::Zero();
+};
+
+PlantSimConfig ParsePlantSimConfig(const ConfigNode& plant_sim);
+
+}  // namespace stewart

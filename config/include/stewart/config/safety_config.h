@@ -1,0 +1,51 @@
+#pragma once
+#include <string>
+#include <vector>
+
+#include "stewart/config/config_node.h"
+
+namespace stewart {
+
+/// Position limit on one pose axis: h = upper - q_j or h = q_j - lower.
+struct PositionLimitConfig {
+  int axis = 0;  ///< index into q
+  std::optional<double> lower, upper;
+  double alpha_e = 1.0;  ///< energy weight of the energy-based barrier (N, J/m)
+  double alpha = 1.0;    ///< class-K gain (1/s)
+};
+
+/// Velocity limit on one pose axis: h_v = upper - qd_j or h_v = qd_j - lower.
+struct VelocityLimitConfig {
+  int axis = 0;
+  std::optional<double> lower, upper;
+  double alpha_v = 1.0;  ///< class-K gain (1/s)
+};
+
+struct LegStrokeLimitConfig {
+  bool enabled = false;
+  double margin_m = 0.0;  ///< kept from each stroke end
+  double alpha_e = 1.0;
+  double alpha = 1.0;
+};
+
+enum class SafetyVariant { kClosedForm, kPaperRule, kQpReference };
+enum class SafetyFallback { kHold, kZero };
+
+/// `safety`: the CBF filter's constraints and parameters.
+struct SafetyConfig {
+  SafetyVariant variant = SafetyVariant::kClosedForm;
+  double k_position = 1.0;  ///< LSE sharpness of the position group
+  double k_velocity = 1.0;  ///< LSE sharpness of the velocity group
+  std::vector<PositionLimitConfig> position_limits;
+  std::vector<VelocityLimitConfig> velocity_limits;
+  LegStrokeLimitConfig leg_stroke;
+  bool force_limits_enabled = false;
+  double stale_age_s = 0.02;
+  SafetyFallback fallback = SafetyFallback::kHold;
+};
+
+SafetyConfig ParseSafetyConfig(const ConfigNode& safety);
+std::string ToString(SafetyVariant variant);
+SafetyVariant ParseSafetyVariant(const std::string& name);  ///< throws std::invalid_argument
+
+}  // namespace stewart

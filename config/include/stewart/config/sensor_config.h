@@ -1,0 +1,22 @@
+#pragma once
+#include "stewart/config/config_node.h"
+
+namespace stewart {
+
+/// `sensors`: the potentiometers and the IMU, as simulated and as expected.
+struct SensorConfig {
+  double rate_hz = 1000.0;
+  double leg_pot_noise_std_m = 0.0;
+  int leg_adc_bits = 10;  ///< quantisation over the stroke; 0 = none
+  double gyro_noise_std_radps = 0.0;
+  Vector3d gyro_bias_radps = Vector3d::Zero();
+  double accel_noise_std_mps2 = 0.0;
+  Vector3d accel_bias_mps2 = Vector3d::Zero();
+  bool has_orientation = false;
+  double orientation_noise_std_rad = 0.0;
+  unsigned seed = 0;
+};
+
+SensorConfig ParseSensorConfig(const ConfigNode& sensors);
+
+}  // namespace stewart

@@ -1,0 +1,14 @@
+#include "stewart/config/controller_config.h"
+
+namespace stewart {
+
+ControllerConfig ParseControllerConfig(const ConfigNode& controller) {
+  ControllerConfig c;
+  c.kp = controller.Vec6("kp");
+  c.kd = controller.Vec6("kd");
+  if ((c.kp.array() <= 0.0).any()) controller.Fail("kp", "every gain must be positive");
+  if ((c.kd.array() <= 0.0).any()) controller.Fail("kd", "every gain must be positive");
+  return c;
+}
+
+}  // namespace stewart

@@ -1,0 +1,53 @@
+#include "stewart/config/lcm_config.h"
+
+namespace stewart {
+namespace {
+
+struct ChannelField {
+  const char* key;
+  std::string ChannelNames::*member;
+};
+constexpr ChannelField kChannelFields[] = {
+    {"sensors", &ChannelNames::sensors},
+    {"state_estimate", &ChannelNames::state_estimate},
+    {"state_truth", &ChannelNames::state_truth},
+    {"setpoint", &ChannelNames::setpoint},
+    {"command_nominal", &ChannelNames::command_nominal},
+    {"command_safe", &ChannelNames::command_safe},
+    {"safety_diagnostics", &ChannelNames::safety_diagnostics},
+    {"health", &ChannelNames::health},
+};
+
+}  // namespace
+
+LcmConfig ParseLcmConfig(const ConfigNode& lcm, const ConfigNode& rates) {
+  LcmConfig c;
+  c.url = lcm.String("url");
+  c.channel_prefix = lcm.String("channel_prefix");
+  c.channel_suffix = lcm.Has("channel_suffix") ? lcm.String("channel_suffix") : "";
+  const ConfigNode channels = lcm.Child("channels");
+  for (const ChannelField& field : kChannelFields) {
+    const std::string base = channels.String(field.key);
+    if (base.empty()) channels.Fail(field.key, "channel name must not be empty");
+    c.channels.*field.member = base;
+  }
+  // Store bare names, then apply prefix and suffix in one place.
+  const std::string suffix = c.channel_suffix;
+  c.channel_suffix.clear();
+  for (const ChannelField& field : kChannelFields) {
+    c.channels.*field.member = c.channel_prefix + c.channels.*field.member;
+  }
+  SetChannelSuffix(&c, suffix);
+  c.health_rate_hz = rates.PositiveDouble("health_hz");
+  return c;
+}
+
+void SetChannelSuffix(LcmConfig* lcm, const std::string& suffix) {
+  for (const ChannelField& field : kChannelFields) {
+    std::string& name = lcm->channels.*field.member;
+    name = name.substr(0, name.size() - lcm->channel_suffix.size()) + suffix;
+  }
+  lcm->channel_suffix = suffix;
+}
+
+}  // namespace stewart

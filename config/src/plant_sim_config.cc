@@ -1,0 +1,17 @@
+#include "stewart/config/plant_sim_config.h"
+
+namespace stewart {
+
+PlantSimConfig ParsePlantSimConfig(const ConfigNode& plant_sim) {
+  PlantSimConfig p;
+  p.rel_tol = plant_sim.PositiveDouble("rel_tol");
+  p.abs_tol = plant_sim.PositiveDouble("abs_tol");
+  p.command_timeout_s = plant_sim.PositiveDouble("command_timeout_s");
+  p.timeout_fallback = plant_sim.Choice("timeout_fallback", {"off", "hold_last"});
+  p.lockstep_timeout_s = plant_sim.PositiveDouble("lockstep_timeout_s");
+  p.initial_pose = plant_sim.Vec6("initial_pose");
+  p.initial_velocity = plant_sim.Vec6("initial_velocity");
+  return p;
+}
+
+}  // namespace stewart

@@ -1,0 +1,56 @@
+#include "stewart/config/platform_config.h"
+
+namespace stewart {
+
+PlatformParams ParsePlatformParams(const ConfigNode& root) {
+  const ConfigNode platform = root.Child("platform");
+  const ConfigNode legs = root.Child("legs");
+  const ConfigNode actuators = root.Child("actuators");
+
+  PlatformParams p;
+  p.base_joints_m = JointsOnCircle(platform.PositiveDouble("base_joint_radius_m"),
+                                   platform.Array6("base_joint_angles_deg"));
+  p.platform_joints_m = JointsOnCircle(platform.PositiveDouble("platform_joint_radius_m"),
+                                       platform.Array6("platform_joint_angles_deg"));
+  p.platform_mass_kg = platform.PositiveDouble("mass_kg");
+  p.platform_com_m = platform.Vec3("com_m");
+  p.platform_inertia_kgm2 = platform.Vec3("inertia_kgm2");
+  for (int i = 0; i < 3; ++i) {
+    if (!(p.platform_inertia_kgm2(i) > 0.0)) {
+      platform.Fail("inertia_kgm2", "principal inertias must be positive");
+    }
+  }
+  const Vector3d I = p.platform_inertia_kgm2;
+  if (I(0) + I(1) < I(2) || I(1) + I(2) < I(0) || I(0) + I(2) < I(1)) {
+    platform.Fail("inertia_kgm2", "violates the triangle inequality of a rigid body");
+  }
+  p.gravity_mps2 = platform.NonNegativeDouble("gravity_mps2");
+
+  p.leg.cylinder_mass_kg = legs.NonNegativeDouble("cylinder_mass_kg");
+  p.leg.cylinder_com_from_base_m = legs.NonNegativeDouble("cylinder_com_from_base_m");
+  p.leg.cylinder_inertia_kgm2 = legs.NonNegativeDouble("cylinder_inertia_kgm2");
+  p.leg.rod_mass_kg = legs.NonNegativeDouble("rod_mass_kg");
+  p.leg.rod_com_from_platform_m = legs.NonNegativeDouble("rod_com_from_platform_m");
+  p.leg.rod_inertia_kgm2 = legs.NonNegativeDouble("rod_inertia_kgm2");
+
+  p.leg_min_length_m = actuators.PositiveDouble("min_length_m");
+  p.leg_max_length_m = p.leg_min_length_m + actuators.PositiveDouble("stroke_m");
+  if (p.leg.rod_com_from_platform_m >= p.leg_min_length_m) {
+    legs.Fail("rod_com_from_platform_m", "must be shorter than actuators.min_length_m");
+  }
+  return p;
+}
+
+ActuatorConfig ParseActuatorConfig(const ConfigNode& actuators) {
+  ActuatorConfig a;
+  a.min_length_m = actuators.PositiveDouble("min_length_m");
+  a.stroke_m = actuators.PositiveDouble("stroke_m");
+  a.force_limit_n = actuators.PositiveDouble("force_limit_n");
+  a.viscous_friction_nspm = actuators.NonNegativeDouble("viscous_friction_nspm");
+  a.force_lag_s = actuators.NonNegativeDouble("force_lag_s");
+  a.endstop_stiffness_npm = actuators.PositiveDouble("endstop_stiffness_npm");
+  a.endstop_damping_nspm = actuators.NonNegativeDouble("endstop_damping_nspm");
+  return a;
+}
+
+}  // namespace stewart

@@ -1,0 +1,85 @@
+#include "stewart/config/safety_config.h"
+
+#include <stdexcept>
+
+namespace stewart {
+namespace {
+
+int ParseAxis(const ConfigNode& node) {
+  const std::string name = node.Choice("axis", {"x", "y", "z", "phi", "theta", "psi"});
+  for (int i = 0; i < kNumAxes; ++i) {
+    if (kAxisNames[static_cast<size_t>(i)] == name) return i;
+  }
+  return 0;  // unreachable: Choice validated the name
+}
+
+template <typename Limit>
+void ParseBounds(const ConfigNode& node, Limit* limit) {
+  limit->lower = node.OptionalDouble("lower");
+  limit->upper = node.OptionalDouble("upper");
+  if (!limit->lower && !limit->upper) node.Fail("upper", "give lower, upper or both");
+  if (limit->lower && limit->upper && !(*limit->lower < *limit->upper)) {
+    node.Fail("lower", "must be below upper");
+  }
+}
+
+}  // namespace
+
+std::string ToString(SafetyVariant variant) {
+  switch (variant) {
+    case SafetyVariant::kClosedForm:
+      return "closed_form";
+    case SafetyVariant::kPaperRule:
+      return "paper";
+    case SafetyVariant::kQpReference:
+      return "qp";
+  }
+  return "?";
+}
+
+SafetyVariant ParseSafetyVariant(const std::string& name) {
+  if (name == "closed_form") return SafetyVariant::kClosedForm;
+  if (name == "paper") return SafetyVariant::kPaperRule;
+  if (name == "qp") return SafetyVariant::kQpReference;
+  throw std::invalid_argument("unknown safety variant '" + name + "' (closed_form | paper | qp)");
+}
+
+SafetyConfig ParseSafetyConfig(const ConfigNode& safety) {
+  SafetyConfig s;
+  s.variant = ParseSafetyVariant(safety.Choice("variant", {"closed_form", "paper", "qp"}));
+  s.k_position = safety.PositiveDouble("k_position");
+  s.k_velocity = safety.PositiveDouble("k_velocity");
+  for (const ConfigNode& node : safety.List("position_limits")) {
+    PositionLimitConfig limit;
+    limit.axis = ParseAxis(node);
+    ParseBounds(node, &limit);
+    limit.alpha_e = node.PositiveDouble("alpha_e");
+    limit.alpha = node.PositiveDouble("alpha");
+    s.position_limits.push_back(limit);
+  }
+  for (const ConfigNode& node : safety.List("velocity_limits")) {
+    VelocityLimitConfig limit;
+    limit.axis = ParseAxis(node);
+    ParseBounds(node, &limit);
+    if (limit.upper && !(*limit.upper > 0.0)) {
+      node.Fail("upper", "must be positive: standing still has to be safe");
+    }
+    if (limit.lower && !(*limit.lower < 0.0)) {
+      node.Fail("lower", "must be negative: standing still has to be safe");
+    }
+    limit.alpha_v = node.PositiveDouble("alpha_v");
+    s.velocity_limits.push_back(limit);
+  }
+  const ConfigNode leg = safety.Child("leg_stroke");
+  s.leg_stroke.enabled = leg.Bool("enabled");
+  s.leg_stroke.margin_m = leg.NonNegativeDouble("margin_m");
+  s.leg_stroke.alpha_e = leg.PositiveDouble("alpha_e");
+  s.leg_stroke.alpha = leg.PositiveDouble("alpha");
+  s.force_limits_enabled = safety.Bool("force_limits_enabled");
+  s.stale_age_s = safety.PositiveDouble("stale_age_s");
+  s.fallback = safety.Choice("fallback", {"hold", "zero"}) == "hold" ? SafetyFallback::kHold
+                                                                     : SafetyFallback::kZero;
+  return s;
+}
+
+}  // namespace stewart

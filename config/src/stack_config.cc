@@ -1,0 +1,111 @@
+#include "stewart/config/stack_config.h"
+
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+
+#include "stewart/model/kinematics.h"
+
+namespace stewart {
+namespace {
+
+std::string Fmt(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+void ValidatePoseInStroke(const PlatformParams& platform, const Vector6d& pose,
+                          const std::string& key) {
+  const Vector6d lengths = InverseKinematics(platform, pose);
+  for (int i = 0; i < kNumLegs; ++i) {
+    if (!(lengths(i) >= platform.leg_min_length_m && lengths(i) <= platform.leg_max_length_m)) {
+      throw ConfigError(key, "leg " + std::to_string(i) + " length " + Fmt(lengths(i)) +
+                                 " m is outside the actuator stroke [" +
+                                 Fmt(platform.leg_min_length_m) + ", " +
+                                 Fmt(platform.leg_max_length_m) + "] m");
+    }
+  }
+}
+
+StackConfig ParseRoot(const YAML::Node& yaml, const std::string& source) {
+  const ConfigNode root(yaml, "");
+  StackConfig c;
+  c.source_path = source;
+  c.platform = ParsePlatformParams(root);
+  c.home_pose = root.Child("platform").Vec6("home_pose");
+  c.actuators = ParseActuatorConfig(root.Child("actuators"));
+  c.sensors = ParseSensorConfig(root.Child("sensors"));
+  c.controller = ParseControllerConfig(root.Child("controller"));
+  c.safety = ParseSafetyConfig(root.Child("safety"));
+  c.estimator = ParseEstimatorConfig(root.Child("estimator"));
+  c.plant_sim = ParsePlantSimConfig(root.Child("plant_sim"));
+  c.hw_bridge = ParseHwBridgeConfig(root.Child("hw_bridge"));
+  c.lcm = ParseLcmConfig(root.Child("lcm"), root.Child("rates"));
+  ValidateStackConfig(c);
+  return c;
+}
+
+}  // namespace
+
+void ValidateStackConfig(const StackConfig& c) {
+  ValidatePoseInStroke(c.platform, c.home_pose, "platform.home_pose");
+  ValidatePoseInStroke(c.platform, c.plant_sim.initial_pose, "plant_sim.initial_pose");
+  for (std::size_t i = 0; i < c.safety.position_limits.size(); ++i) {
+    const PositionLimitConfig& limit = c.safety.position_limits[i];
+    const double home = c.home_pose(limit.axis);
+    const std::string key = "safety.position_limits[" + std::to_string(i) + "]";
+    const std::string axis(kAxisNames[static_cast<size_t>(limit.axis)]);
+    if (limit.upper && !(home < *limit.upper)) {
+      throw ConfigError(key + ".upper",
+                        "excludes the home pose (" + axis + " = " + Fmt(home) + ")");
+    }
+    if (limit.lower && !(home > *limit.lower)) {
+      throw ConfigError(key + ".lower",
+                        "excludes the home pose (" + axis + " = " + Fmt(home) + ")");
+    }
+  }
+  if (c.safety.leg_stroke.enabled) {
+    const Vector6d lengths = InverseKinematics(c.platform, c.home_pose);
+    const double margin = c.safety.leg_stroke.margin_m;
+    if ((lengths.array() <= c.platform.leg_min_length_m + margin).any() ||
+        (lengths.array() >= c.platform.leg_max_length_m - margin).any()) {
+      throw ConfigError("safety.leg_stroke.margin_m",
+                        "excludes the home pose from the stroke limits");
+    }
+  }
+}
+
+StackConfig ParseStackConfig(const std::string& yaml_text) {
+  YAML::Node yaml;
+  try {
+    yaml = YAML::Load(yaml_text);
+  } catch (const YAML::Exception& e) {
+    throw ConfigError("<yaml>", std::string("not valid YAML: ") + e.what());
+  }
+  return ParseRoot(yaml, "");
+}
+
+StackConfig LoadStackConfig(const std::string& path) {
+  std::ifstream file(path);
+  if (!file) throw ConfigError("<file>", "cannot open '" + path + "'");
+  std::stringstream text;
+  text << file.rdbuf();
+  YAML::Node yaml;
+  try {
+    yaml = YAML::Load(text.str());
+  } catch (const YAML::Exception& e) {
+    throw ConfigError("<yaml>", "'" + path + "' is not valid YAML: " + e.what());
+  }
+  return ParseRoot(yaml, path);
+}
+
+std::string DefaultConfigPath() {
+  if (const char* env = std::getenv("STEWART_CONFIG"); env != nullptr && *env != '\0') {
+    return env;
+  }
+  return std::string(STEWART_SOURCE_DIR) + "/config/platform.yaml";
+}
+
+}  // namespace stewart

@@ -1,0 +1,24 @@
+#pragma once
+#include <CLI/CLI.hpp>
+#include <string>
+
+#include "stewart/config/stack_config.h"
+
+namespace stewart {
+
+/// Flags every node shares: one config, optional LCM URL and channel-suffix
+/// overrides (launch.sh gives each run a private URL).
+struct NodeOptions {
+  std::string config_path;
+  std::string lcm_url;         ///< "" = lcm.url from the config
+  std::string channel_suffix;  ///< "" = lcm.channel_suffix from the config
+  std::string log_level = "info";
+};
+
+void AddNodeOptions(CLI::App* app, NodeOptions* options);
+
+/// Loads the config and applies the overrides. On a bad config logs one clear
+/// line naming the key and exits with status 2.
+StackConfig LoadNodeConfigOrExit(const NodeOptions& options);
+
+}  // namespace stewart

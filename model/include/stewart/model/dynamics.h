@@ -1,0 +1,47 @@
+#pragma once
+// Task-space rigid-body dynamics of the Stewart platform (paper eq. 2):
+//
+//   M(q) qdd + C(q, qd) qd + G(q) = H(q) F,   H = J_l^T,
+//
+// q = [x y z phi theta psi] (m, rad; Euler rates, see rotation.h),
+// F = leg forces (N, positive extends the leg), M in kg / kg m / kg m^2,
+// C qd and G in N / N m (generalised forces conjugate to q).
+//
+// Derived from one Lagrangian (platform rigid body + two bodies per leg,
+// docs/model.md), so qd^T (Mdot - 2C) qd = 0 holds exactly (power balance),
+// which the energy-based CBF relies on.
+#include "stewart/model/kinematics.h"
+#include "stewart/model/platform_params.h"
+#include "stewart/model/types.h"
+
+namespace stewart {
+
+/// Everything a process needs from the model at one state.
+struct DynamicsTerms {
+  Matrix6d M;     ///< inertia matrix, symmetric positive definite
+  Vector6d C_qd;  ///< Coriolis and centrifugal generalised force C(q,qd) qd
+  Vector6d G;     ///< gravity generalised force dV/dq
+  Matrix6d H;     ///< J_l^T: maps leg forces to generalised forces
+  Vector6d leg_length_m;
+};
+
+/// Evaluates M, C qd, G and H at (q, qd). No heap allocation.
+void EvaluateDynamics(const PlatformParams& params, const Vector6d& q, const Vector6d& qd,
+                      DynamicsTerms* terms);
+DynamicsTerms EvaluateDynamics(const PlatformParams& params, const Vector6d& q, const Vector6d& qd);
+
+/// qdd = M^-1 (H F - C qd - G).
+Vector6d ForwardDynamics(const DynamicsTerms& terms, const Vector6d& force_n);
+
+/// The F that solves H F = M qdd + C qd + G (H is invertible away from
+/// singular poses; a least-squares answer is returned there).
+Vector6d InverseDynamics(const DynamicsTerms& terms, const Vector6d& qdd);
+
+/// Kinetic energy 1/2 qd^T M qd (J).
+double KineticEnergy(const DynamicsTerms& terms, const Vector6d& qd);
+
+/// Gravitational potential energy V(q) with dV/dq = G(q) (J, zero at z = 0
+/// for every body).
+double PotentialEnergy(const PlatformParams& params, const Vector6d& q);
+
+}  // namespace stewart

@@ -1,0 +1,27 @@
+#pragma once
+// Fixed-size Eigen types shared by every component. Fixed sizes keep the hot
+// paths free of heap allocation.
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <array>
+#include <string_view>
+
+namespace stewart {
+
+constexpr int kNumLegs = 6;
+constexpr int kNumAxes = 6;
+
+using Vector3d = Eigen::Vector3d;
+using Matrix3d = Eigen::Matrix3d;
+using Vector6d = Eigen::Matrix<double, 6, 1>;
+using Matrix6d = Eigen::Matrix<double, 6, 6>;
+using Matrix36d = Eigen::Matrix<double, 3, 6>;
+
+/// Pose axes in the order of q = [x y z phi theta psi] (m, m, m, rad, rad, rad).
+enum class Axis : int { kX = 0, kY = 1, kZ = 2, kPhi = 3, kTheta = 4, kPsi = 5 };
+
+/// Names of the pose axes as used in the config and the docs.
+inline constexpr std::array<std::string_view, kNumAxes> kAxisNames = {"x",   "y",     "z",
+                                                                      "phi", "theta", "psi"};
+
+}  // namespace stewart

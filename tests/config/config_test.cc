@@ -1,0 +1,150 @@
+// Every invalid value gives one ConfigError naming the key and the reason.
+#include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
+
+#include <array>
+#include <cstdio>
+#include <fstream>
+#include <functional>
+#include <limits>
+
+#include "stewart/config/stack_config.h"
+
+namespace stewart {
+namespace {
+
+YAML::Node DefaultYaml() { return YAML::LoadFile(DefaultConfigPath()); }
+
+std::string Emit(const YAML::Node& node) {
+  YAML::Emitter out;
+  out << node;
+  return out.c_str();
+}
+
+// Expects the mutated config to fail with an error at `key` whose reason
+// contains `reason_part`.
+void ExpectConfigError(const std::function<void(YAML::Node&)>& mutate, const std::string& key,
+                       const std::string& reason_part) {
+  YAML::Node yaml = DefaultYaml();
+  mutate(yaml);
+  try {
+    ParseStackConfig(Emit(yaml));
+    ADD_FAILURE() << "no error for " << key;
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(e.key(), key) << e.what();
+    EXPECT_NE(e.reason().find(reason_part), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find(key), std::string::npos);
+  }
+}
+
+TEST(Config, DefaultLoadsWithPaperValues) {
+  const StackConfig c = LoadStackConfig(DefaultConfigPath());
+  EXPECT_DOUBLE_EQ(c.platform.base_joints_m.col(0).norm(), 0.20);
+  EXPECT_DOUBLE_EQ(c.platform.platform_joints_m.col(0).norm(), 0.16);
+  EXPECT_DOUBLE_EQ(c.platform.leg_max_length_m - c.platform.leg_min_length_m, 0.2);
+  EXPECT_DOUBLE_EQ(c.home_pose(2), 0.4);
+  EXPECT_EQ(c.safety.position_limits.size(), 3u);
+  EXPECT_EQ(c.safety.velocity_limits.size(), 3u);
+  EXPECT_DOUBLE_EQ(c.safety.velocity_limits[2].alpha_v, 2.0);  // paper: z alpha_v = 2
+  EXPECT_EQ(c.lcm.channels.sensors, "STEWART_SENSORS");
+  EXPECT_EQ(c.lcm.channels.command_safe, "STEWART_CMD_SAFE");
+}
+
+TEST(Config, ChannelSuffix) {
+  StackConfig c = LoadStackConfig(DefaultConfigPath());
+  SetChannelSuffix(&c.lcm, "_B");
+  EXPECT_EQ(c.lcm.channels.state_estimate, "STEWART_STATE_EST_B");
+  SetChannelSuffix(&c.lcm, "_C");
+  EXPECT_EQ(c.lcm.channels.state_estimate, "STEWART_STATE_EST_C");
+  SetChannelSuffix(&c.lcm, "");
+  EXPECT_EQ(c.lcm.channels.state_estimate, "STEWART_STATE_EST");
+}
+
+TEST(Config, MissingKey) {
+  ExpectConfigError([](YAML::Node& y) { y["platform"].remove("mass_kg"); }, "platform.mass_kg",
+                    "missing");
+  ExpectConfigError([](YAML::Node& y) { y.remove("safety"); }, "safety", "missing");
+  ExpectConfigError([](YAML::Node& y) { y["lcm"]["channels"].remove("health"); },
+                    "lcm.channels.health", "missing");
+}
+
+TEST(Config, WrongType) {
+  ExpectConfigError([](YAML::Node& y) { y["safety"]["k_position"] = "large"; }, "safety.k_position",
+                    "expected a number");
+  ExpectConfigError([](YAML::Node& y) { y["controller"]["kp"] = 3.0; }, "controller.kp",
+                    "list of 6");
+  ExpectConfigError([](YAML::Node& y) { y["sensors"]["has_orientation"] = "maybe"; },
+                    "sensors.has_orientation", "true or false");
+  ExpectConfigError([](YAML::Node& y) { y["safety"]["variant"] = "fastest"; }, "safety.variant",
+                    "not one of");
+  ExpectConfigError([](YAML::Node& y) { y["safety"]["position_limits"][0]["axis"] = "w"; },
+                    "safety.position_limits[0].axis", "not one of");
+}
+
+TEST(Config, NotANumber) {
+  ExpectConfigError([](YAML::Node& y) { y["platform"]["mass_kg"] = ".nan"; }, "platform.mass_kg",
+                    "finite");
+  ExpectConfigError([](YAML::Node& y) { y["controller"]["kd"][3] = ".inf"; }, "controller.kd[3]",
+                    "finite");
+}
+
+TEST(Config, NegativeMassAndInertia) {
+  ExpectConfigError([](YAML::Node& y) { y["platform"]["mass_kg"] = -1.0; }, "platform.mass_kg",
+                    "positive");
+  ExpectConfigError([](YAML::Node& y) { y["legs"]["rod_mass_kg"] = -0.1; }, "legs.rod_mass_kg",
+                    "negative");
+  ExpectConfigError([](YAML::Node& y) { y["platform"]["inertia_kgm2"][2] = 1.0; },
+                    "platform.inertia_kgm2", "triangle");
+}
+
+TEST(Config, LimitsExcludingHomePose) {
+  ExpectConfigError([](YAML::Node& y) { y["safety"]["position_limits"][2]["upper"] = 0.39; },
+                    "safety.position_limits[2].upper", "home pose");
+  ExpectConfigError(
+      [](YAML::Node& y) {
+        y["safety"]["position_limits"][0].remove("upper");
+        y["safety"]["position_limits"][0]["lower"] = 0.05;
+      },
+      "safety.position_limits[0].lower", "home pose");
+  ExpectConfigError([](YAML::Node& y) { y["safety"]["velocity_limits"][0]["upper"] = -0.01; },
+                    "safety.velocity_limits[0].upper", "standing still");
+  ExpectConfigError(
+      [](YAML::Node& y) {
+        y["safety"]["leg_stroke"]["enabled"] = true;
+        y["safety"]["leg_stroke"]["margin_m"] = 0.05;
+      },
+      "safety.leg_stroke.margin_m", "home pose");
+}
+
+TEST(Config, HomePoseOutsideStroke) {
+  ExpectConfigError([](YAML::Node& y) { y["platform"]["home_pose"][2] = 0.7; },
+                    "platform.home_pose", "outside the actuator stroke");
+  ExpectConfigError([](YAML::Node& y) { y["actuators"]["stroke_m"] = 0.02; }, "platform.home_pose",
+                    "outside the actuator stroke");
+}
+
+TEST(Config, InvalidYamlAndMissingFile) {
+  EXPECT_THROW(ParseStackConfig("platform: [unclosed"), ConfigError);
+  EXPECT_THROW(LoadStackConfig("/nonexistent/platform.yaml"), ConfigError);
+}
+
+// A process given a bad config exits non-zero with one line naming the key.
+TEST(Config, ToolExitsNonZeroNamingTheKey) {
+  YAML::Node yaml = DefaultYaml();
+  yaml["platform"]["mass_kg"] = -2.0;
+  const std::string path = ::testing::TempDir() + "bad_config.yaml";
+  std::ofstream(path) << Emit(yaml);
+  const std::string cmd = std::string(MODEL_TOOL_PATH) + " --config " + path + " 2>&1";
+  FILE* pipe = popen(cmd.c_str(), "r");
+  ASSERT_NE(pipe, nullptr);
+  std::string output;
+  std::array<char, 256> buffer{};
+  while (fgets(buffer.data(), buffer.size(), pipe) != nullptr) output += buffer.data();
+  const int status = pclose(pipe);
+  EXPECT_NE(status, 0);
+  EXPECT_NE(output.find("platform.mass_kg"), std::string::npos) << output;
+  EXPECT_NE(output.find("positive"), std::string::npos) << output;
+}
+
+}  // namespace
+}  // namespace stewart
