@@ -4,6 +4,7 @@
 
 #include <random>
 
+#include "stewart/model/imu.h"
 #include "stewart/model/rotation.h"
 #include "test_states.h"
 
@@ -111,6 +112,39 @@ TEST(Kinematics, WorkspaceChecks) {
   EXPECT_FALSE(PoseInWorkspace(c.platform, q));
   q(4) = std::numeric_limits<double>::quiet_NaN();
   EXPECT_FALSE(PoseInWorkspace(c.platform, q));
+}
+
+}  // namespace
+}  // namespace stewart
+
+namespace stewart {
+namespace {
+
+// The IMU equations against finite differences of the pose.
+TEST(Imu, GyroAndAccelerometerMatchFiniteDifferences) {
+  std::mt19937 rng(4);
+  const double g = 9.81;
+  const Vector3d offset(0.01, -0.02, 0.03);
+  for (int n = 0; n < 200; ++n) {
+    const Vector6d q = test::RandomPose(&rng);
+    const Vector6d qd = test::RandomVelocity(&rng);
+    const Vector6d qdd = test::RandomVelocity(&rng);
+    const double h = 1e-5;
+    // Point position p(t) = t + R r, along the quadratic path q + qd t + qdd t^2/2.
+    auto point = [&](double t) {
+      const Vector6d qt = q + qd * t + 0.5 * qdd * t * t;
+      return Vector3d(qt.head<3>() + RotationFromEuler(qt.tail<3>()) * offset);
+    };
+    const Vector3d a_fd = (point(h) - 2 * point(0) + point(-h)) / (h * h);
+    const Matrix3d R = RotationFromEuler(q.tail<3>());
+    const Vector3d expected_f = R.transpose() * (a_fd + Vector3d(0, 0, g));
+    EXPECT_LT((ImuSpecificForce(q, qd, qdd, offset, g) - expected_f).norm(), 1e-4);
+    const Matrix3d Rdot =
+        (RotationFromEuler((q + h * qd).tail<3>()) - RotationFromEuler((q - h * qd).tail<3>())) /
+        (2 * h);
+    const Matrix3d W = R.transpose() * Rdot;  // [omega_P]x
+    EXPECT_LT((BodyAngularVelocity(q, qd) - Vector3d(W(2, 1), W(0, 2), W(1, 0))).norm(), 1e-8);
+  }
 }
 
 }  // namespace
