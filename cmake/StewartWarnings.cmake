@@ -1,8 +1,11 @@
 # Warnings as errors on our own code only (generated LCM headers and system
 # headers are included as SYSTEM so their warnings never fail the build).
 function(stewart_target_warnings target)
+  # maybe-uninitialized stays a warning: GCC 12 raises it inside lcm-gen's
+  # decode code once it is inlined into ours, where -isystem cannot hide it.
   target_compile_options(${target} PRIVATE -Wall -Wextra -Wpedantic -Wshadow
-                                           -Wnon-virtual-dtor -Werror)
+                                           -Wnon-virtual-dtor -Werror
+                                           -Wno-error=maybe-uninitialized)
 endfunction()
 
 # Release builds keep assertions off but stay debuggable.

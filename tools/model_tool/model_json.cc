@@ -58,6 +58,16 @@ nlohmann::json EvaluateModelQuery(const PlatformParams& params, const ModelQuery
   out["leg_length_m"] = ToJson(terms.leg_length_m);
   out["in_stroke"] = LegLengthsWithinStroke(params, terms.leg_length_m);
   out["in_workspace"] = PoseInWorkspace(params, query.q);
+  const LegGeometry legs = ComputeLegGeometry(params, query.q);
+  nlohmann::json base = nlohmann::json::array(), top = nlohmann::json::array();
+  for (int i = 0; i < kNumLegs; ++i) {
+    const Vector3d b = params.base_joints_m.col(i);
+    const Vector3d a = query.q.head<3>() + legs.platform_offset_m.col(i);
+    base.push_back({b.x(), b.y(), b.z()});
+    top.push_back({a.x(), a.y(), a.z()});
+  }
+  out["base_joints_m"] = base;      // b_i in {B}
+  out["platform_joints_m"] = top;   // a_i = t + R p_i in {B}
   out["J_l"] = ToJson(Matrix6d(terms.H.transpose()));
   out["M"] = ToJson(terms.M);
   out["C_qd"] = ToJson(terms.C_qd);
