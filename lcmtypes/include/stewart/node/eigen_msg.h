@@ -13,7 +13,9 @@ Eigen::Matrix<double, static_cast<int>(N), 1> FromArray(const double (&a)[N]) {
 template <std::size_t N, typename Derived>
 void ToArray(const Eigen::MatrixBase<Derived>& v, double (&a)[N]) {
   static_assert(Derived::SizeAtCompileTime == static_cast<int>(N), "size mismatch");
-  Eigen::Map<Eigen::Matrix<double, static_cast<int>(N), 1>>(a) = v;
+  // A named Map: `Map<...>(a) = v;` would parse as a declaration of `a`.
+  Eigen::Map<Eigen::Matrix<double, static_cast<int>(N), 1>> out(a);
+  out = v;
 }
 
 /// True iff every element is finite.

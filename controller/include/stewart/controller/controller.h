@@ -1,0 +1,68 @@
+#pragma once
+// The controller's state machine, free of LCM: setpoint source (scenario or
+// live), workspace rejection, time from the state's utime, and the control law.
+#include <cstdint>
+#include <optional>
+
+#include "stewart/config/controller_config.h"
+#include "stewart/controller/control_law.h"
+#include "stewart/controller/scenario.h"
+#include "stewart/model/dynamics.h"
+
+namespace stewart {
+
+enum class SetpointStatus { kAccepted, kNonFinite, kOutsideWorkspace };
+enum class StepStatus { kOk, kNonFiniteState, kTimeNotIncreasing, kNonFiniteForce };
+
+const char* ToString(SetpointStatus status);
+const char* ToString(StepStatus status);
+
+struct ControllerOutput {
+  Vector6d force_n = Vector6d::Zero();  ///< F_des (N)
+  Setpoint setpoint;                    ///< the setpoint F_des tracks
+  /// The latest requested setpoint (live message or scenario sample) was
+  /// rejected; `setpoint` is the last valid one (or the home pose).
+  bool setpoint_rejected = false;
+  /// Scenario mode: this step's scenario sample was rejected (count it).
+  std::optional<SetpointStatus> scenario_rejection;
+  double scenario_time_s = 0.0;  ///< t since the first valid state (s)
+};
+
+class Controller {
+ public:
+  /// Without a scenario, setpoints come from OfferSetpoint (live); until the
+  /// first valid one arrives the controller holds `home_pose`.
+  Controller(const PlatformParams& platform, const ControllerConfig& gains,
+             const Vector6d& home_pose, std::optional<Scenario> scenario = std::nullopt);
+
+  /// Live mode: checks the setpoint and adopts it if valid; a rejected one
+  /// keeps the last valid setpoint. When following a scenario it only
+  /// returns the check (scenario nodes do not subscribe to live setpoints).
+  SetpointStatus OfferSetpoint(const Setpoint& setpoint);
+
+  /// One control step for the state at `utime` (us). On kOk fills `out`; on
+  /// any other status `out` is untouched and nothing must be published.
+  StepStatus Step(int64_t utime, const Vector6d& q, const Vector6d& qd, ControllerOutput* out);
+
+  bool following_scenario() const { return scenario_.has_value(); }
+  const std::optional<Scenario>& scenario() const { return scenario_; }
+  /// True once a state at t >= duration_s has been processed.
+  bool scenario_finished() const { return scenario_finished_; }
+  const Setpoint& active_setpoint() const { return active_; }
+  const DynamicsTerms& last_terms() const { return terms_; }
+
+ private:
+  SetpointStatus Check(const Setpoint& setpoint) const;
+
+  PlatformParams platform_;
+  ControllerConfig gains_;
+  std::optional<Scenario> scenario_;
+  Setpoint active_;
+  bool rejected_ = false;
+  bool scenario_finished_ = false;
+  std::optional<int64_t> first_utime_;
+  std::optional<int64_t> last_utime_;
+  DynamicsTerms terms_{};
+};
+
+}  // namespace stewart

@@ -1,0 +1,40 @@
+#pragma once
+// Wires stewart::Controller to LCM: state estimate in, nominal force command
+// (and, when following a scenario, the active setpoint) out.
+#include <lcm/lcm-cpp.hpp>
+#include <memory>
+#include <optional>
+
+#include "stewart/config/stack_config.h"
+#include "stewart/controller/controller.h"
+#include "stewart/force_command_t.hpp"
+#include "stewart/node/health_reporter.h"
+#include "stewart/setpoint_t.hpp"
+#include "stewart/state_t.hpp"
+
+namespace stewart {
+
+class ControllerNode {
+ public:
+  ControllerNode(const StackConfig& config, std::optional<Scenario> scenario, bool exit_at_end);
+
+  /// Runs until a stop signal, or the scenario's end with exit_at_end.
+  int Run();
+
+  void OnState(const lcm::ReceiveBuffer* rbuf, const std::string& channel, const state_t* msg);
+  void OnSetpoint(const lcm::ReceiveBuffer* rbuf, const std::string& channel,
+                  const setpoint_t* msg);
+
+ private:
+  StackConfig config_;
+  std::unique_ptr<lcm::LCM> lcm_;
+  Controller controller_;
+  HealthReporter health_;
+  bool exit_at_end_;
+  int64_t command_seq_ = 0;
+  int64_t setpoint_seq_ = 0;
+  force_command_t command_{};
+  setpoint_t setpoint_echo_{};
+};
+
+}  // namespace stewart

@@ -1,0 +1,18 @@
+#include "stewart/controller/control_law.h"
+
+namespace stewart {
+
+Vector6d PdAcceleration(const ControllerConfig& gains, const Vector6d& q, const Vector6d& qd,
+                        const Setpoint& setpoint) {
+  return setpoint.qdd_des - gains.kp.cwiseProduct(q - setpoint.q_des) -
+         gains.kd.cwiseProduct(qd - setpoint.qd_des);
+}
+
+Vector6d NominalForce(const PlatformParams& platform, const ControllerConfig& gains,
+                      const Vector6d& q, const Vector6d& qd, const Setpoint& setpoint,
+                      DynamicsTerms* terms) {
+  EvaluateDynamics(platform, q, qd, terms);
+  return InverseDynamics(*terms, PdAcceleration(gains, q, qd, setpoint));
+}
+
+}  // namespace stewart

@@ -1,0 +1,85 @@
+#include "stewart/controller/controller.h"
+
+#include "stewart/model/kinematics.h"
+
+namespace stewart {
+
+const char* ToString(SetpointStatus status) {
+  switch (status) {
+    case SetpointStatus::kAccepted:
+      return "accepted";
+    case SetpointStatus::kNonFinite:
+      return "setpoint_non_finite";
+    case SetpointStatus::kOutsideWorkspace:
+      return "setpoint_outside_workspace";
+  }
+  return "?";
+}
+
+const char* ToString(StepStatus status) {
+  switch (status) {
+    case StepStatus::kOk:
+      return "ok";
+    case StepStatus::kNonFiniteState:
+      return "state_non_finite";
+    case StepStatus::kTimeNotIncreasing:
+      return "state_time_not_increasing";
+    case StepStatus::kNonFiniteForce:
+      return "force_non_finite";
+  }
+  return "?";
+}
+
+Controller::Controller(const PlatformParams& platform, const ControllerConfig& gains,
+                       const Vector6d& home_pose, std::optional<Scenario> scenario)
+    : platform_(platform),
+      gains_(gains),
+      scenario_(std::move(scenario)),
+      active_(Setpoint::HoldAt(home_pose)) {}
+
+SetpointStatus Controller::Check(const Setpoint& setpoint) const {
+  if (!setpoint.AllFinite()) return SetpointStatus::kNonFinite;
+  if (!PoseInWorkspace(platform_, setpoint.q_des)) return SetpointStatus::kOutsideWorkspace;
+  return SetpointStatus::kAccepted;
+}
+
+SetpointStatus Controller::OfferSetpoint(const Setpoint& setpoint) {
+  const SetpointStatus status = Check(setpoint);
+  if (scenario_) return status;
+  rejected_ = status != SetpointStatus::kAccepted;
+  if (!rejected_) active_ = setpoint;
+  return status;
+}
+
+StepStatus Controller::Step(int64_t utime, const Vector6d& q, const Vector6d& qd,
+                            ControllerOutput* out) {
+  if (!q.allFinite() || !qd.allFinite()) return StepStatus::kNonFiniteState;
+  if (last_utime_ && utime <= *last_utime_) return StepStatus::kTimeNotIncreasing;
+  last_utime_ = utime;
+  if (!first_utime_) first_utime_ = utime;
+  const double t_s = 1e-6 * static_cast<double>(utime - *first_utime_);
+
+  std::optional<SetpointStatus> scenario_rejection;
+  if (scenario_) {
+    const Setpoint sample = scenario_->Evaluate(t_s);
+    const SetpointStatus status = Check(sample);
+    rejected_ = status != SetpointStatus::kAccepted;
+    if (rejected_) {
+      scenario_rejection = status;
+    } else {
+      active_ = sample;
+    }
+    if (t_s >= scenario_->duration_s()) scenario_finished_ = true;
+  }
+
+  const Vector6d force_n = NominalForce(platform_, gains_, q, qd, active_, &terms_);
+  if (!force_n.allFinite()) return StepStatus::kNonFiniteForce;
+  out->force_n = force_n;
+  out->setpoint = active_;
+  out->setpoint_rejected = rejected_;
+  out->scenario_rejection = scenario_rejection;
+  out->scenario_time_s = t_s;
+  return StepStatus::kOk;
+}
+
+}  // namespace stewart

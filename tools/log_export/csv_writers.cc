@@ -1,0 +1,183 @@
+#include "csv_writers.h"
+
+#include <cstring>
+#include <iomanip>
+#include <memory>
+
+#include "stewart/force_command_t.hpp"
+#include "stewart/health_t.hpp"
+#include "stewart/safety_diagnostics_t.hpp"
+#include "stewart/sensor_t.hpp"
+#include "stewart/setpoint_t.hpp"
+#include "stewart/state_t.hpp"
+
+namespace stewart {
+namespace {
+
+constexpr const char* kAxes[6] = {"x", "y", "z", "phi", "theta", "psi"};
+
+std::string AxisColumns(const std::string& name, const std::string& unit_lin,
+                        const std::string& unit_ang) {
+  std::string s;
+  for (int i = 0; i < 6; ++i) {
+    s += "," + name + "_" + kAxes[i] + "_" + (i < 3 ? unit_lin : unit_ang);
+  }
+  return s;
+}
+
+std::string IndexedColumns(const std::string& name, int n, const std::string& unit) {
+  std::string s;
+  for (int i = 0; i < n; ++i) s += "," + name + std::to_string(i) + "_" + unit;
+  return s;
+}
+
+template <int N>
+void Values(std::ostream& out, const double (&values)[N]) {
+  for (int i = 0; i < N; ++i) out << ',' << values[i];
+}
+
+void Values(std::ostream& out, const std::vector<double>& values, std::size_t n) {
+  for (std::size_t i = 0; i < n; ++i) out << ',' << (i < values.size() ? values[i] : 0.0);
+}
+
+template <typename Msg>
+class TypedWriter : public CsvChannelWriter {
+ public:
+  bool WriteRow(const void* data, int size, std::ostream& out) const override {
+    Msg msg;
+    if (msg.decode(data, 0, size) != size) return false;
+    out << msg.utime << ',' << msg.seq << ',' << msg.sample_utime;
+    Row(msg, out);
+    out << '\n';
+    return true;
+  }
+  std::string Header() const override { return "utime_us,seq,sample_utime_us" + Columns(); }
+
+ protected:
+  virtual std::string Columns() const = 0;
+  virtual void Row(const Msg& msg, std::ostream& out) const = 0;
+};
+
+class SensorWriter : public TypedWriter<sensor_t> {
+  std::string Columns() const override {
+    return IndexedColumns("leg_length", 6, "m") + ",gyro_x_radps,gyro_y_radps,gyro_z_radps" +
+           ",accel_x_mps2,accel_y_mps2,accel_z_mps2,has_orientation" +
+           ",roll_rad,pitch_rad,yaw_rad,status";
+  }
+  void Row(const sensor_t& m, std::ostream& out) const override {
+    Values(out, m.leg_length_m);
+    Values(out, m.gyro_radps);
+    Values(out, m.accel_mps2);
+    out << ',' << int{m.has_orientation};
+    Values(out, m.orientation_rpy_rad);
+    out << ',' << m.status;
+  }
+};
+
+class StateWriter : public TypedWriter<state_t> {
+  std::string Columns() const override {
+    return AxisColumns("q", "m", "rad") + AxisColumns("qd", "mps", "radps") +
+           AxisColumns("q_std", "m", "rad") + AxisColumns("qd_std", "mps", "radps") + ",status";
+  }
+  void Row(const state_t& m, std::ostream& out) const override {
+    Values(out, m.q);
+    Values(out, m.qd);
+    Values(out, m.q_std);
+    Values(out, m.qd_std);
+    out << ',' << m.status;
+  }
+};
+
+class SetpointWriter : public TypedWriter<setpoint_t> {
+  std::string Columns() const override {
+    return AxisColumns("q_des", "m", "rad") + AxisColumns("qd_des", "mps", "radps") +
+           AxisColumns("qdd_des", "mps2", "radps2");
+  }
+  void Row(const setpoint_t& m, std::ostream& out) const override {
+    Values(out, m.q_des);
+    Values(out, m.qd_des);
+    Values(out, m.qdd_des);
+  }
+};
+
+class ForceCommandWriter : public TypedWriter<force_command_t> {
+  std::string Columns() const override { return IndexedColumns("force", 6, "n") + ",flags"; }
+  void Row(const force_command_t& m, std::ostream& out) const override {
+    Values(out, m.force_n);
+    out << ',' << m.flags;
+  }
+};
+
+class DiagnosticsWriter : public TypedWriter<safety_diagnostics_t> {
+  // Barrier arrays vary in length between configs; the CSV keeps the
+  // composed quantities, which every config has, plus the first barriers.
+  std::string Columns() const override {
+    return ",variant,active_case,infeasible,fallback_reason,h_pos,h_vel,psi_p,psi_v,mu_p,mu_v" +
+           IndexedColumns("g_p", 6, "") + IndexedColumns("g_v", 6, "") +
+           IndexedColumns("f_des", 6, "n") + IndexedColumns("f_safe", 6, "n") +
+           IndexedColumns("mu_force", 6, "") + ",correction_norm_n,compute_ns,num_position," +
+           "num_velocity" + IndexedColumns("h_position", 8, "") +
+           IndexedColumns("h_velocity", 8, "");
+  }
+  void Row(const safety_diagnostics_t& m, std::ostream& out) const override {
+    out << ',' << int{m.variant} << ',' << int{m.active_case} << ',' << int{m.infeasible} << ','
+        << m.fallback_reason << ',' << m.h_pos << ',' << m.h_vel << ',' << m.psi_p << ',' << m.psi_v
+        << ',' << m.mu_p << ',' << m.mu_v;
+    Values(out, m.g_p);
+    Values(out, m.g_v);
+    Values(out, m.f_des);
+    Values(out, m.f_safe);
+    Values(out, m.mu_force);
+    out << ',' << m.correction_norm << ',' << m.compute_ns << ',' << m.num_position << ','
+        << m.num_velocity;
+    Values(out, m.h_position, 8);
+    Values(out, m.h_velocity, 8);
+  }
+};
+
+class HealthWriter : public TypedWriter<health_t> {
+  std::string Columns() const override {
+    return ",name,state,messages_in,messages_out,rejected_inputs,counters,last_error";
+  }
+  void Row(const health_t& m, std::ostream& out) const override {
+    out << ',' << m.name << ',' << int{m.state} << ',' << m.messages_in << ',' << m.messages_out
+        << ',' << m.rejected_inputs << ",\"";
+    for (std::size_t i = 0; i < m.counter_names.size(); ++i) {
+      out << (i ? ";" : "") << m.counter_names[i] << '=' << m.counter_values[i];
+    }
+    std::string error = m.last_error;
+    for (char& c : error) {
+      if (c == '"' || c == '\n') c = '\'';
+    }
+    out << "\",\"" << error << '"';
+  }
+};
+
+int64_t PayloadHash(const void* data, int size) {
+  if (size < 8) return 0;
+  const auto* bytes = static_cast<const uint8_t*>(data);
+  uint64_t hash = 0;
+  for (int i = 0; i < 8; ++i) hash = (hash << 8) | bytes[i];
+  return static_cast<int64_t>(hash);
+}
+
+}  // namespace
+
+const CsvChannelWriter* FindCsvWriter(const void* data, int size) {
+  static const SensorWriter sensor;
+  static const StateWriter state;
+  static const SetpointWriter setpoint;
+  static const ForceCommandWriter command;
+  static const DiagnosticsWriter diagnostics;
+  static const HealthWriter health;
+  const int64_t hash = PayloadHash(data, size);
+  if (hash == sensor_t::getHash()) return &sensor;
+  if (hash == state_t::getHash()) return &state;
+  if (hash == setpoint_t::getHash()) return &setpoint;
+  if (hash == force_command_t::getHash()) return &command;
+  if (hash == safety_diagnostics_t::getHash()) return &diagnostics;
+  if (hash == health_t::getHash()) return &health;
+  return nullptr;
+}
+
+}  // namespace stewart

@@ -1,0 +1,24 @@
+#pragma once
+// One CSV row format per message type; the header names every column with
+// its unit, as in docs/messages.md.
+#include <cstdint>
+#include <ostream>
+#include <string>
+#include <vector>
+
+namespace stewart {
+
+/// Decodes one LCM payload of a known stewart type and writes it as CSV.
+class CsvChannelWriter {
+ public:
+  virtual ~CsvChannelWriter() = default;
+  virtual std::string Header() const = 0;
+  /// Returns false if the payload does not decode as this type.
+  virtual bool WriteRow(const void* data, int size, std::ostream& out) const = 0;
+};
+
+/// The writer for a payload, chosen by the type hash in its first 8 bytes;
+/// nullptr for a type this project does not define.
+const CsvChannelWriter* FindCsvWriter(const void* data, int size);
+
+}  // namespace stewart
