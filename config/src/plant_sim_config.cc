@@ -4,6 +4,10 @@ namespace stewart {
 
 PlantSimConfig ParsePlantSimConfig(const ConfigNode& plant_sim) {
   PlantSimConfig p;
+  // Optional, so configs written before the key existed keep loading.
+  if (plant_sim.Has("integrator")) {
+    p.integrator = plant_sim.Choice("integrator", {"arkode_erk", "cvode_bdf", "cvode_adams"});
+  }
   p.rel_tol = plant_sim.PositiveDouble("rel_tol");
   p.abs_tol = plant_sim.PositiveDouble("abs_tol");
   p.command_timeout_s = plant_sim.PositiveDouble("command_timeout_s");

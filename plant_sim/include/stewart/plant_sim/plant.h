@@ -1,0 +1,64 @@
+#pragma once
+// The simulated platform: plant state, zero-order-hold inputs and the
+// SUNDIALS integration between control ticks (docs/simulation.md).
+#include "stewart/plant_sim/ode_integrator.h"
+#include "stewart/plant_sim/plant_dynamics.h"
+
+namespace stewart {
+
+struct PlantCounters {
+  long endstop_hits = 0;  ///< times a leg entered an end-stop (stroke end crossed outwards)
+  OdeStats ode;
+};
+
+class Plant {
+ public:
+  Plant(const PlantModel& model, const OdeOptions& ode_options);
+
+  /// Restarts at time t_s (s) in state (q, qd) with zero motor force and the
+  /// actuators on.
+  void Reset(double t_s, const Vector6d& q, const Vector6d& qd);
+
+  /// Zero-order hold: the command acts from now until the next change.
+  /// A change restarts the integrator, since f(x) jumps.
+  void SetForceCommand(const Vector6d& force_cmd_n);
+  /// Actuators off: zero force, and the lead screws hold every leg at its
+  /// length at this instant (LegLockForce). Restarts the integrator on change.
+  void SetActuatorsOff(bool off);
+
+  /// Integrates the held inputs over dt_s (s). Stops and restarts at every
+  /// stroke-end crossing (the end-stop force is not smooth there), counting
+  /// entries into an end-stop. Throws std::runtime_error if SUNDIALS fails.
+  void Advance(double dt_s);
+
+  double time_s() const { return t_s_; }
+  Vector6d q() const { return PoseOf(x_); }
+  Vector6d qd() const { return VelocityOf(x_); }
+  const PlantStateVector& state() const { return x_; }
+  const PlantInputs& inputs() const { return inputs_; }
+  bool actuators_off() const { return inputs_.legs_locked; }
+  const PlantModel& model() const { return model_; }
+
+  /// Right-hand side at the current state with the inputs held now
+  /// (acceleration qdd, total leg forces, model terms).
+  const PlantRates& EvaluateRates();
+  /// True iff a leg is now beyond either stroke end (inside an end-stop).
+  bool InEndStop() const;
+  PlantCounters counters() const;
+
+ private:
+  static int Rhs(double t, const double* y, double* y_dot, void* self);
+  static int Roots(double t, const double* y, double* g, void* self);
+  void MarkDiscontinuity() { restart_pending_ = true; }
+
+  PlantModel model_;
+  OdeIntegrator integrator_;
+  PlantInputs inputs_;
+  PlantStateVector x_ = PlantStateVector::Zero();
+  double t_s_ = 0.0;
+  bool restart_pending_ = true;
+  long endstop_hits_ = 0;
+  PlantRates rates_;  // scratch of Rhs/EvaluateRates: no allocation per call
+};
+
+}  // namespace stewart

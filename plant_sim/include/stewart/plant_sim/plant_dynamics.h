@@ -1,0 +1,55 @@
+#pragma once
+// The simulator's ODE right-hand side: the model's task-space dynamics
+// (model/dynamics.h, paper eq. 2) driven by the actuator model.
+//
+//   x = [q (m, rad), qd (m/s, rad/s), F_motor (N)]            (18 states)
+//   qd'      = M^-1 (H F_leg - C qd - G),
+//   F_leg    = F_motor - b Ld + F_endstop(L, Ld) [+ F_lock(L, Ld)],  Ld = H^T qd
+//   F_motor' = (sat(F_cmd) - F_motor) / tau     if force_lag_s = tau > 0,
+//   F_motor  = sat(F_cmd) (held in the state, rate 0) otherwise.
+#include <Eigen/Core>
+
+#include "stewart/config/platform_config.h"
+#include "stewart/model/dynamics.h"
+#include "stewart/model/platform_params.h"
+
+namespace stewart {
+
+constexpr int kPlantStateSize = 18;
+using PlantStateVector = Eigen::Matrix<double, kPlantStateSize, 1>;
+
+/// The physical plant: rigid-body model plus actuators.
+struct PlantModel {
+  PlatformParams platform;
+  ActuatorConfig actuators;
+};
+
+/// Inputs held constant over one integration interval (zero-order hold).
+struct PlantInputs {
+  Vector6d force_cmd_n = Vector6d::Zero();  ///< commanded leg forces, before saturation
+  bool legs_locked = false;                 ///< unpowered: the lead screws hold their length
+  Vector6d lock_length_m = Vector6d::Zero();
+};
+
+inline Eigen::Ref<const Vector6d> PoseOf(const PlantStateVector& x) { return x.segment<6>(0); }
+inline Eigen::Ref<const Vector6d> VelocityOf(const PlantStateVector& x) { return x.segment<6>(6); }
+inline Eigen::Ref<const Vector6d> MotorForceOf(const PlantStateVector& x) {
+  return x.segment<6>(12);
+}
+
+/// Everything the right-hand side computed at one state.
+struct PlantRates {
+  PlantStateVector x_dot;
+  Vector6d leg_force_n;  ///< total force along each leg, F_leg
+  DynamicsTerms terms;
+};
+
+/// x_dot = f(x, inputs). No heap allocation.
+void PlantDerivative(const PlantModel& model, const PlantInputs& inputs, const PlantStateVector& x,
+                     PlantRates* rates);
+
+/// T + V + end-stop spring energy (J): constant when F_leg is conservative
+/// (F = 0, no friction, no end-stop damping).
+double PlantMechanicalEnergy(const PlantModel& model, const Vector6d& q, const Vector6d& qd);
+
+}  // namespace stewart

@@ -1,0 +1,248 @@
+#include "plant_sim_node.h"
+
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+#include <cmath>
+#include <thread>
+
+#include "stewart/node/eigen_msg.h"
+#include "stewart/node/lcm_handle.h"
+#include "stewart/node/stop_signal.h"
+#include "stewart/sensor_t.hpp"
+#include "stewart/state_t.hpp"
+
+namespace stewart {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+OdeOptions OdeOptionsFrom(const PlantSimConfig& c) {
+  OdeOptions o;
+  o.method = ParseOdeMethod(c.integrator);
+  o.rel_tol = c.rel_tol;
+  o.abs_tol = c.abs_tol;
+  return o;
+}
+
+int TimeoutMs(Clock::duration d) {
+  const auto ms = std::chrono::duration_cast<std::chrono::milliseconds>(d).count();
+  return static_cast<int>(std::max<int64_t>(0, std::min<int64_t>(ms, 50)));
+}
+
+}  // namespace
+
+PlantSimNode::PlantSimNode(const StackConfig& config, const PlantSimOptions& options)
+    : config_(config),
+      options_(options),
+      lcm_(MakeLcm(config.lcm.url)),
+      plant_(PlantModel{config.platform, config.actuators}, OdeOptionsFrom(config.plant_sim)),
+      sensors_(config.sensors, config.actuators, config.platform.gravity_mps2),
+      health_("plant_sim", config.lcm.channels.health, config.lcm.health_rate_hz),
+      hold_(config.plant_sim.command_timeout_s,
+            ParseTimeoutFallback(config.plant_sim.timeout_fallback)) {
+  period_us_ = std::llround(1e6 / config.sensors.rate_hz);
+  if (period_us_ <= 0) throw std::invalid_argument("sensors.rate_hz is too high (period < 1 us)");
+  plant_.Reset(0.0, config.plant_sim.initial_pose, config.plant_sim.initial_velocity);
+  lcm::Subscription* sub =
+      lcm_->subscribe(config.lcm.channels.command_safe, &PlantSimNode::HandleCommand, this);
+  sub->setQueueCapacity(1000);  // a burst must never be dropped silently
+}
+
+int PlantSimNode::Run() {
+  int status = 0;
+  try {
+    health_.SetState(health_t::STATE_OK);
+    status = options_.mode == SimMode::kLockstep ? RunLockstep() : RunRealTime();
+  } catch (const std::exception& e) {
+    spdlog::error("plant_sim: {}", e.what());
+    health_.SetState(health_t::STATE_FAULT);
+    health_.SetError(e.what());
+    status = 4;
+  }
+  if (status == 0) health_.SetState(health_t::STATE_STOPPED);
+  health_.MaybePublish(lcm_.get(), true);
+  const PlantCounters c = plant_.counters();
+  spdlog::info("plant_sim: stopped at t = {:.3f} s after {} ticks; {} end-stop hits, {} rhs evals",
+               plant_.time_s(), tick_, c.endstop_hits, c.ode.rhs_evals);
+  return status;
+}
+
+void PlantSimNode::PublishSample() {
+  tick_utime_ = utime0_ + tick_ * period_us_;
+  const PlantRates& rates = plant_.EvaluateRates();
+  const SensorReading r =
+      sensors_.Sample(plant_.q(), plant_.qd(), rates.x_dot.segment<6>(6), rates.terms.leg_length_m);
+  sensor_t& s = last_sensor_;
+  s = sensor_t{};
+  s.utime = tick_utime_;
+  s.seq = tick_;
+  s.sample_utime = tick_utime_;
+  ToArray(r.leg_length_m, s.leg_length_m);
+  ToArray(r.gyro_radps, s.gyro_radps);
+  ToArray(r.accel_mps2, s.accel_mps2);
+  s.has_orientation = r.has_orientation;
+  ToArray(r.orientation_rpy_rad, s.orientation_rpy_rad);
+  s.status = 0;
+  if (plant_.InEndStop()) s.status |= sensor_t::STATUS_ENDSTOP;
+  if (plant_.actuators_off()) s.status |= sensor_t::STATUS_ACTUATORS_OFF;
+  lcm_->publish(config_.lcm.channels.sensors, &s);
+
+  state_t truth{};
+  truth.utime = tick_utime_;
+  truth.seq = tick_;
+  truth.sample_utime = tick_utime_;
+  ToArray(plant_.q(), truth.q);
+  ToArray(plant_.qd(), truth.qd);
+  truth.status = state_t::STATUS_VALID | state_t::STATUS_GROUND_TRUTH;
+  lcm_->publish(config_.lcm.channels.state_truth, &truth);
+  health_.CountOut();
+  health_.CountOut();
+  health_.SetStackTime(tick_utime_, tick_utime_);
+}
+
+void PlantSimNode::AdvanceTick() {
+  plant_.Advance(static_cast<double>(period_us_) * 1e-6);
+  const PlantCounters c = plant_.counters();
+  health_.SetCounter("endstop_hits", c.endstop_hits);
+  health_.SetCounter("ticks", tick_ + 1);
+  health_.MaybePublish(lcm_.get());
+}
+
+void PlantSimNode::HandleCommand(const lcm::ReceiveBuffer*, const std::string&,
+                                 const force_command_t* msg) {
+  health_.CountIn();
+  const Vector6d force_n = FromArray(msg->force_n);
+  const std::string problem = ForceCommandProblem(force_n);
+  if (!problem.empty()) {
+    health_.Reject(problem, "force_command_t seq " + std::to_string(msg->seq));
+    return;
+  }
+  if (options_.mode == SimMode::kLockstep) {
+    switch (MatchLockstepCommand(tick_utime_, msg->sample_utime)) {
+      case LockstepMatch::kAnswer:
+        if (answered_) {
+          health_.Reject("duplicate_answer", "sample_utime " + std::to_string(msg->sample_utime));
+          return;
+        }
+        answered_ = true;
+        answer_force_n_ = force_n;
+        return;
+      case LockstepMatch::kStale:
+        health_.Reject("stale_sample_utime", std::to_string(msg->sample_utime) + " < awaited " +
+                                                 std::to_string(tick_utime_));
+        return;
+      case LockstepMatch::kFuture:
+        health_.Reject("future_sample_utime", std::to_string(msg->sample_utime) + " > awaited " +
+                                                  std::to_string(tick_utime_));
+        return;
+    }
+  }
+  if (msg->sample_utime > tick_utime_) {
+    health_.Reject("future_sample_utime", std::to_string(msg->sample_utime));
+    return;
+  }
+  if (msg->sample_utime < last_applied_sample_utime_) {
+    health_.Reject("out_of_order", std::to_string(msg->sample_utime));
+    return;
+  }
+  last_applied_sample_utime_ = msg->sample_utime;
+  hold_.OnCommand(force_n, plant_.time_s());
+}
+
+void PlantSimNode::ApplyRealTimeDecision() {
+  const RealTimeCommandHold::Decision d = hold_.Decide(plant_.time_s());
+  plant_.SetActuatorsOff(d.actuators_off);
+  if (!d.actuators_off) plant_.SetForceCommand(d.force_cmd_n);
+  if (d.timed_out != fallback_active_) {
+    fallback_active_ = d.timed_out;
+    if (d.timed_out) {
+      const std::string what =
+          d.actuators_off ? "actuators off, lead screws hold the legs" : "holding the last command";
+      health_.SetError("no force_command_t on " + config_.lcm.channels.command_safe + " for " +
+                       std::to_string(config_.plant_sim.command_timeout_s) + " s: " + what);
+      health_.SetState(health_t::STATE_DEGRADED);
+      health_.Count("command_timeouts");
+      spdlog::warn("plant_sim: command timeout at t = {:.3f} s: {}", plant_.time_s(), what);
+    } else {
+      health_.SetError("");
+      health_.SetState(health_t::STATE_OK);
+      spdlog::info("plant_sim: commands resumed at t = {:.3f} s", plant_.time_s());
+    }
+  }
+  health_.SetCounter("fallback_active", fallback_active_ ? 1 : 0);
+}
+
+int PlantSimNode::RunRealTime() {
+  utime0_ = options_.start_utime >= 0 ? options_.start_utime
+                                      : std::chrono::duration_cast<std::chrono::microseconds>(
+                                            std::chrono::system_clock::now().time_since_epoch())
+                                            .count();
+  const auto period = std::chrono::microseconds(period_us_);
+  const Clock::time_point start = Clock::now();
+  for (tick_ = 0;; ++tick_) {
+    const Clock::time_point deadline = start + tick_ * period;
+    // Commands are taken in while waiting for the tick; the one newest at
+    // the tick acts over the whole following interval (zero-order hold).
+    while (!StopRequested()) {
+      const Clock::duration left = deadline - Clock::now();
+      if (left <= Clock::duration::zero()) break;
+      if (left < std::chrono::milliseconds(1)) {
+        lcm_->handleTimeout(0);
+        std::this_thread::sleep_until(deadline);
+        break;
+      }
+      lcm_->handleTimeout(TimeoutMs(left));
+    }
+    while (lcm_->handleTimeout(0) > 0) {
+    }
+    if (StopRequested()) break;
+    PublishSample();
+    if (options_.duration_s > 0.0 && plant_.time_s() >= options_.duration_s - 1e-9) break;
+    ApplyRealTimeDecision();
+    AdvanceTick();
+  }
+  return 0;
+}
+
+int PlantSimNode::RunLockstep() {
+  utime0_ = std::max<int64_t>(options_.start_utime, 0);
+  const auto timeout = std::chrono::duration_cast<Clock::duration>(
+      std::chrono::duration<double>(config_.plant_sim.lockstep_timeout_s));
+  const auto republish = std::chrono::duration_cast<Clock::duration>(
+      std::chrono::duration<double>(options_.startup_republish_s));
+  for (tick_ = 0;; ++tick_) {
+    answered_ = false;
+    PublishSample();
+    if (options_.duration_s > 0.0 && plant_.time_s() >= options_.duration_s - 1e-9) break;
+    const Clock::time_point waiting_since = Clock::now();
+    Clock::time_point last_sent = waiting_since;
+    while (!answered_) {
+      if (StopRequested()) return 0;
+      const Clock::time_point now = Clock::now();
+      if (now - waiting_since >= timeout) {
+        const std::string what = "lockstep: no force_command_t on " +
+                                 config_.lcm.channels.command_safe + " with sample_utime " +
+                                 std::to_string(tick_utime_) + " (tick " + std::to_string(tick_) +
+                                 ") within " +
+                                 std::to_string(config_.plant_sim.lockstep_timeout_s) + " s";
+        spdlog::error("plant_sim: {}", what);
+        health_.SetState(health_t::STATE_FAULT);
+        health_.SetError(what);
+        return 3;
+      }
+      if (tick_ == 0 && options_.startup_republish_s > 0.0 && now - last_sent >= republish) {
+        // The stored message, byte for byte: a new draw would change the noise sequence.
+        lcm_->publish(config_.lcm.channels.sensors, &last_sensor_);
+        last_sent = now;
+      }
+      lcm_->handleTimeout(TimeoutMs(timeout - (now - waiting_since)));
+      health_.MaybePublish(lcm_.get());
+    }
+    plant_.SetForceCommand(answer_force_n_);
+    AdvanceTick();
+  }
+  return 0;
+}
+
+}  // namespace stewart

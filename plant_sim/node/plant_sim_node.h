@@ -1,0 +1,65 @@
+#pragma once
+// The plant_sim process: the simulated platform on LCM (docs/simulation.md).
+// Publishes sensor_t and the ground-truth state_t at every tick, health_t as
+// a heartbeat, and applies force_command_t from the safety filter.
+#include <lcm/lcm-cpp.hpp>
+#include <memory>
+#include <string>
+
+#include "stewart/config/stack_config.h"
+#include "stewart/force_command_t.hpp"
+#include "stewart/node/health_reporter.h"
+#include "stewart/plant_sim/command_policy.h"
+#include "stewart/plant_sim/plant.h"
+#include "stewart/plant_sim/sensor_model.h"
+#include "stewart/sensor_t.hpp"
+
+namespace stewart {
+
+enum class SimMode { kRealTime, kLockstep };
+
+struct PlantSimOptions {
+  SimMode mode = SimMode::kRealTime;
+  double duration_s = 0.0;  ///< simulated seconds; 0 = until SIGINT/SIGTERM
+  /// utime of tick 0 (us); < 0 = wall clock (real time) or 0 (lockstep).
+  int64_t start_utime = -1;
+  /// Lockstep: re-sends tick 0's sample at this wall period until it is
+  /// answered, for a stack that subscribes after plant_sim started. 0 = never.
+  double startup_republish_s = 0.25;
+};
+
+class PlantSimNode {
+ public:
+  PlantSimNode(const StackConfig& config, const PlantSimOptions& options);
+  /// Runs to the end of the duration or a stop signal. Returns the exit status:
+  /// 0 clean, 3 lockstep timeout, 4 integration failure.
+  int Run();
+
+ private:
+  int RunRealTime();
+  int RunLockstep();
+  void PublishSample();
+  void ApplyRealTimeDecision();
+  void AdvanceTick();
+  void HandleCommand(const lcm::ReceiveBuffer* rbuf, const std::string& channel,
+                     const force_command_t* msg);
+
+  StackConfig config_;
+  PlantSimOptions options_;
+  std::unique_ptr<lcm::LCM> lcm_;
+  Plant plant_;
+  SensorModel sensors_;
+  HealthReporter health_;
+  RealTimeCommandHold hold_;
+  int64_t period_us_ = 1000;
+  int64_t utime0_ = 0;
+  int64_t tick_ = 0;        // index of the newest published sample
+  int64_t tick_utime_ = 0;  // its utime
+  int64_t last_applied_sample_utime_ = -1;
+  bool answered_ = false;  // lockstep: the command for tick_ arrived
+  Vector6d answer_force_n_ = Vector6d::Zero();
+  bool fallback_active_ = false;
+  sensor_t last_sensor_{};
+};
+
+}  // namespace stewart

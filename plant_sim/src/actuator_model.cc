@@ -1,0 +1,55 @@
+#include "stewart/plant_sim/actuator_model.h"
+
+namespace stewart {
+
+Vector6d SaturateForce(const ActuatorConfig& actuators, const Vector6d& force_cmd_n) {
+  const double f_max = actuators.force_limit_n;
+  return force_cmd_n.cwiseMax(-f_max).cwiseMin(f_max);
+}
+
+Vector6d FrictionForce(const ActuatorConfig& actuators, const Vector6d& leg_speed_mps) {
+  return -actuators.viscous_friction_nspm * leg_speed_mps;
+}
+
+Vector6d EndStopForce(const ActuatorConfig& actuators, const Vector6d& leg_length_m,
+                      const Vector6d& leg_speed_mps) {
+  const double l_min = actuators.min_length_m;
+  const double l_max = actuators.min_length_m + actuators.stroke_m;
+  const double k = actuators.endstop_stiffness_npm;
+  const double c = actuators.endstop_damping_nspm;
+  Vector6d force = Vector6d::Zero();
+  for (int i = 0; i < kNumLegs; ++i) {
+    const double below = l_min - leg_length_m(i);
+    const double above = leg_length_m(i) - l_max;
+    if (below > 0.0) {
+      force(i) = std::max(0.0, k * below - c * leg_speed_mps(i));
+    } else if (above > 0.0) {
+      force(i) = std::min(0.0, -k * above - c * leg_speed_mps(i));
+    }
+  }
+  return force;
+}
+
+double EndStopPotentialEnergy(const ActuatorConfig& actuators, const Vector6d& leg_length_m) {
+  const double l_min = actuators.min_length_m;
+  const double l_max = actuators.min_length_m + actuators.stroke_m;
+  double energy_j = 0.0;
+  for (int i = 0; i < kNumLegs; ++i) {
+    const double d = std::max({0.0, l_min - leg_length_m(i), leg_length_m(i) - l_max});
+    energy_j += 0.5 * actuators.endstop_stiffness_npm * d * d;
+  }
+  return energy_j;
+}
+
+Vector6d LegLockForce(const ActuatorConfig& actuators, const Vector6d& leg_length_m,
+                      const Vector6d& leg_speed_mps, const Vector6d& lock_length_m) {
+  return -actuators.endstop_stiffness_npm * (leg_length_m - lock_length_m) -
+         actuators.endstop_damping_nspm * leg_speed_mps;
+}
+
+Vector6d ForceLagRate(const ActuatorConfig& actuators, const Vector6d& force_sat_n,
+                      const Vector6d& force_motor_n) {
+  return (force_sat_n - force_motor_n) / actuators.force_lag_s;
+}
+
+}  // namespace stewart

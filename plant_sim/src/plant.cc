@@ -1,0 +1,124 @@
+#include "stewart/plant_sim/plant.h"
+
+#include <array>
+#include <stdexcept>
+#include <string>
+
+#include "stewart/model/kinematics.h"
+#include "stewart/plant_sim/actuator_model.h"
+
+namespace stewart {
+namespace {
+
+// Root functions: g_i = L_i - l_min and g_{6+i} = l_max - L_i; a falling
+// zero crossing means a leg enters an end-stop.
+constexpr int kNumRoots = 2 * kNumLegs;
+// A segment that keeps stopping at roots without reaching its end is a
+// chattering contact; far more than any real impact sequence in one tick.
+constexpr int kMaxRootStopsPerAdvance = 10000;
+
+}  // namespace
+
+Plant::Plant(const PlantModel& model, const OdeOptions& ode_options)
+    : model_(model),
+      integrator_(ode_options, kPlantStateSize, kNumRoots, &Plant::Rhs, &Plant::Roots, this) {}
+
+void Plant::Reset(double t_s, const Vector6d& q, const Vector6d& qd) {
+  t_s_ = t_s;
+  x_.setZero();
+  x_.segment<6>(0) = q;
+  x_.segment<6>(6) = qd;
+  inputs_ = PlantInputs{};
+  endstop_hits_ = 0;
+  MarkDiscontinuity();
+}
+
+void Plant::SetForceCommand(const Vector6d& force_cmd_n) {
+  if (force_cmd_n == inputs_.force_cmd_n) return;
+  inputs_.force_cmd_n = force_cmd_n;
+  if (!(model_.actuators.force_lag_s > 0.0)) {
+    // Without lag the motor force is the saturated command; the state keeps it for output.
+    x_.segment<6>(12) = SaturateForce(model_.actuators, force_cmd_n);
+  }
+  MarkDiscontinuity();
+}
+
+void Plant::SetActuatorsOff(bool off) {
+  if (off == inputs_.legs_locked) return;
+  inputs_.legs_locked = off;
+  if (off) {
+    inputs_.lock_length_m = InverseKinematics(model_.platform, q());
+    SetForceCommand(Vector6d::Zero());
+  }
+  MarkDiscontinuity();
+}
+
+void Plant::Advance(double dt_s) {
+  if (!(dt_s > 0.0)) throw std::invalid_argument("Plant::Advance: dt_s must be positive");
+  const double t_end = t_s_ + dt_s;
+  std::array<int, kNumRoots> roots_found{};
+  for (int stops = 0;; ++stops) {
+    if (stops > kMaxRootStopsPerAdvance) {
+      throw std::runtime_error(
+          "plant integration chatters at a stroke end at t = " + std::to_string(t_s_) + " s");
+    }
+    if (restart_pending_) {
+      integrator_.Reinit(t_s_, x_.data());
+      restart_pending_ = false;
+    }
+    double t_reached = t_s_;
+    const OdeIntegrator::Result result =
+        integrator_.Advance(t_end, x_.data(), &t_reached, roots_found.data());
+    t_s_ = t_reached;
+    if (result == OdeIntegrator::Result::kReachedTime) break;
+    for (int i = 0; i < kNumRoots; ++i) {
+      if (roots_found[static_cast<size_t>(i)] < 0) ++endstop_hits_;
+    }
+    MarkDiscontinuity();
+  }
+  t_s_ = t_end;  // the stop time is hit exactly; avoid any drift of the tick grid
+}
+
+const PlantRates& Plant::EvaluateRates() {
+  PlantDerivative(model_, inputs_, x_, &rates_);
+  return rates_;
+}
+
+bool Plant::InEndStop() const {
+  const Vector6d lengths = InverseKinematics(model_.platform, q());
+  const double l_min = model_.actuators.min_length_m;
+  const double l_max = l_min + model_.actuators.stroke_m;
+  return (lengths.array() < l_min).any() || (lengths.array() > l_max).any();
+}
+
+PlantCounters Plant::counters() const {
+  PlantCounters c;
+  c.endstop_hits = endstop_hits_;
+  c.ode = integrator_.stats();
+  return c;
+}
+
+int Plant::Rhs(double /*t*/, const double* y, double* y_dot, void* self) {
+  auto* plant = static_cast<Plant*>(self);
+  const PlantStateVector x = Eigen::Map<const PlantStateVector>(y);
+  PlantDerivative(plant->model_, plant->inputs_, x, &plant->rates_);
+  if (!plant->rates_.x_dot.allFinite()) return 1;  // recoverable: retry a smaller step
+  Eigen::Map<PlantStateVector> x_dot(y_dot);
+  x_dot = plant->rates_.x_dot;
+  return 0;
+}
+
+int Plant::Roots(double /*t*/, const double* y, double* g, void* self) {
+  const auto* plant = static_cast<const Plant*>(self);
+  const Vector6d q = Eigen::Map<const Vector6d>(y);
+  const Vector6d lengths = InverseKinematics(plant->model_.platform, q);
+  const double l_min = plant->model_.actuators.min_length_m;
+  const double l_max = l_min + plant->model_.actuators.stroke_m;
+  Eigen::Map<Vector6d> g_low(g);
+  Eigen::Map<Vector6d> g_high(g + kNumLegs);
+  g_low = lengths.array() - l_min;
+  g_high = l_max - lengths.array();
+  return 0;
+}
+
+}  // namespace stewart

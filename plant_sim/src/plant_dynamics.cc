@@ -1,0 +1,45 @@
+#include "stewart/plant_sim/plant_dynamics.h"
+
+#include "stewart/plant_sim/actuator_model.h"
+
+namespace stewart {
+
+void PlantDerivative(const PlantModel& model, const PlantInputs& inputs, const PlantStateVector& x,
+                     PlantRates* rates) {
+  const Vector6d q = PoseOf(x);
+  const Vector6d qd = VelocityOf(x);
+  DynamicsTerms& terms = rates->terms;
+  EvaluateDynamics(model.platform, q, qd, &terms);
+  const Vector6d& leg_length_m = terms.leg_length_m;
+  const Vector6d leg_speed_mps = terms.H.transpose() * qd;  // Ld = J_l qd, H = J_l^T
+
+  const ActuatorConfig& act = model.actuators;
+  const Vector6d force_sat_n = SaturateForce(act, inputs.force_cmd_n);
+  Vector6d force_motor_n;
+  Vector6d force_motor_rate = Vector6d::Zero();
+  if (act.force_lag_s > 0.0) {
+    force_motor_n = MotorForceOf(x);
+    force_motor_rate = ForceLagRate(act, force_sat_n, force_motor_n);
+  } else {
+    force_motor_n = force_sat_n;
+  }
+
+  Vector6d leg_force_n = force_motor_n + FrictionForce(act, leg_speed_mps) +
+                         EndStopForce(act, leg_length_m, leg_speed_mps);
+  if (inputs.legs_locked) {
+    leg_force_n += LegLockForce(act, leg_length_m, leg_speed_mps, inputs.lock_length_m);
+  }
+  rates->leg_force_n = leg_force_n;
+  rates->x_dot.segment<6>(0) = qd;
+  rates->x_dot.segment<6>(6) = ForwardDynamics(terms, leg_force_n);
+  rates->x_dot.segment<6>(12) = force_motor_rate;
+}
+
+double PlantMechanicalEnergy(const PlantModel& model, const Vector6d& q, const Vector6d& qd) {
+  DynamicsTerms terms;
+  EvaluateDynamics(model.platform, q, qd, &terms);
+  return KineticEnergy(terms, qd) + PotentialEnergy(model.platform, q) +
+         EndStopPotentialEnergy(model.actuators, terms.leg_length_m);
+}
+
+}  // namespace stewart

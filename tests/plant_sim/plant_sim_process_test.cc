@@ -1,0 +1,218 @@
+// The real plant_sim process over LCM (private URLs, ports 7700-7719, ttl=0).
+#include <gtest/gtest.h>
+#include <spawn.h>
+#include <sys/wait.h>
+
+#include <chrono>
+#include <fstream>
+#include <lcm/lcm-cpp.hpp>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "plant_test_util.h"
+#include "stewart/force_command_t.hpp"
+#include "stewart/health_t.hpp"
+#include "stewart/model/kinematics.h"
+#include "stewart/node/lcm_handle.h"
+#include "stewart/sensor_t.hpp"
+#include "stewart/state_t.hpp"
+
+extern char** environ;
+
+namespace stewart {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using test::Config;
+
+class Process {
+ public:
+  explicit Process(std::vector<std::string> args) {
+    args.insert(args.begin(), PLANT_SIM_BIN);
+    std::vector<char*> argv;
+    for (auto& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    if (posix_spawn(&pid_, PLANT_SIM_BIN, nullptr, nullptr, argv.data(), environ) != 0) pid_ = -1;
+  }
+  ~Process() {
+    if (pid_ > 0 && !exited_) {
+      kill(pid_, SIGTERM);
+      Wait();
+    }
+  }
+  bool running() const { return pid_ > 0 && !exited_; }
+  /// Non-blocking; true once the process has exited.
+  bool Poll() {
+    if (exited_) return true;
+    int status = 0;
+    if (waitpid(pid_, &status, WNOHANG) == pid_) {
+      exited_ = true;
+      exit_code_ = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    }
+    return exited_;
+  }
+  int Wait() {
+    int status = 0;
+    if (!exited_ && waitpid(pid_, &status, 0) == pid_) {
+      exited_ = true;
+      exit_code_ = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    }
+    return exit_code_;
+  }
+  int exit_code() const { return exit_code_; }
+
+ private:
+  pid_t pid_ = -1;
+  bool exited_ = false;
+  int exit_code_ = -1;
+};
+
+// Records what plant_sim publishes and, if asked, answers every sensor
+// sample with a leg-space P controller around the holding force.
+class Stack {
+ public:
+  Stack(const std::string& url, bool answer) : lcm_(MakeLcm(url)), answer_(answer) {
+    const auto& ch = Config().lcm.channels;
+    lcm_->subscribe(ch.sensors, &Stack::OnSensor, this)->setQueueCapacity(10000);
+    lcm_->subscribe(ch.state_truth, &Stack::OnTruth, this)->setQueueCapacity(10000);
+    lcm_->subscribe(ch.health, &Stack::OnHealth, this)->setQueueCapacity(100);
+    const Vector6d q0 = Config().plant_sim.initial_pose;
+    hold_n_ = test::HoldingForce(Config().platform, q0);
+    l_target_ = InverseKinematics(Config().platform, q0) + Vector6d::Constant(0.005);
+  }
+  void Spin(double seconds) {
+    const auto end = Clock::now() + std::chrono::duration<double>(seconds);
+    while (Clock::now() < end) lcm_->handleTimeout(5);
+  }
+  void SpinUntilExit(Process* p, double max_seconds) {
+    const auto end = Clock::now() + std::chrono::duration<double>(max_seconds);
+    while (Clock::now() < end && !p->Poll()) lcm_->handleTimeout(5);
+    while (lcm_->handleTimeout(20) > 0) {
+    }
+  }
+  void PublishCommand(int64_t sample_utime, const Vector6d& f) {
+    force_command_t cmd{};
+    cmd.utime = sample_utime;
+    cmd.seq = cmd_seq_++;
+    cmd.sample_utime = sample_utime;
+    for (int i = 0; i < 6; ++i) cmd.force_n[i] = f(i);
+    lcm_->publish(Config().lcm.channels.command_safe, &cmd);
+  }
+
+  std::vector<sensor_t> sensors;
+  std::vector<state_t> truth;
+  std::vector<std::vector<uint8_t>> truth_bytes;
+  std::vector<health_t> health;
+  Vector6d hold_n_, l_target_;
+
+ private:
+  void OnSensor(const lcm::ReceiveBuffer*, const std::string&, const sensor_t* s) {
+    if (!sensors.empty() && sensors.back().seq == s->seq) return;  // startup resend
+    sensors.push_back(*s);
+    if (!answer_) return;
+    Vector6d l;
+    for (int i = 0; i < 6; ++i) l(i) = s->leg_length_m[i];
+    PublishCommand(s->utime, hold_n_ + 800.0 * (l_target_ - l));
+  }
+  void OnTruth(const lcm::ReceiveBuffer* rbuf, const std::string&, const state_t* s) {
+    truth.push_back(*s);
+    const auto* data = static_cast<const uint8_t*>(rbuf->data);
+    truth_bytes.emplace_back(data, data + rbuf->data_size);
+  }
+  void OnHealth(const lcm::ReceiveBuffer*, const std::string&, const health_t* h) {
+    if (h->name == "plant_sim") health.push_back(*h);
+  }
+
+  std::unique_ptr<lcm::LCM> lcm_;
+  bool answer_;
+  int64_t cmd_seq_ = 0;
+};
+
+TEST(PlantSimProcess, RealTimePublishesAndReactsToCommands) {
+  const std::string url = PrivateLcmUrl(7700);
+  Stack stack(url, false);
+  Process sim({"--lcm-url", url, "--mode", "realtime", "--duration", "3", "--log-level", "warn"});
+  ASSERT_TRUE(sim.running());
+  stack.Spin(0.5);  // no commands: actuators off, legs locked
+  ASSERT_GT(stack.sensors.size(), 100u);
+  ASSERT_FALSE(stack.truth.empty());
+  EXPECT_TRUE(stack.sensors.back().status & sensor_t::STATUS_ACTUATORS_OFF);
+  EXPECT_TRUE(stack.truth.back().status & state_t::STATUS_GROUND_TRUTH);
+  const double z_locked = stack.truth.back().q[2];
+  EXPECT_NEAR(z_locked, Config().plant_sim.initial_pose(2), 1e-4);
+  ASSERT_FALSE(stack.health.empty());
+  EXPECT_EQ(stack.health.back().state,
+            static_cast<int8_t>(health_t::STATE_DEGRADED));  // says the fallback is on
+
+  // Push up for 0.3 s: holding force + 3 N per leg, answered every 2 ms.
+  const auto end = Clock::now() + std::chrono::milliseconds(300);
+  while (Clock::now() < end) {
+    stack.PublishCommand(stack.sensors.back().utime, stack.hold_n_ + Vector6d::Constant(3.0));
+    stack.Spin(0.002);
+  }
+  EXPECT_GT(stack.truth.back().q[2], z_locked + 2e-3);
+  EXPECT_FALSE(stack.sensors.back().status & sensor_t::STATUS_ACTUATORS_OFF);
+  // Commands stop: the timeout locks the legs again and health says so.
+  stack.Spin(0.4);
+  EXPECT_TRUE(stack.sensors.back().status & sensor_t::STATUS_ACTUATORS_OFF);
+  EXPECT_EQ(stack.health.back().state, static_cast<int8_t>(health_t::STATE_DEGRADED));
+  const double z_relocked = stack.truth.back().q[2];
+  stack.Spin(0.2);
+  EXPECT_NEAR(stack.truth.back().q[2], z_relocked, 1e-4);
+  // utime runs on the tick grid: 1 kHz -> 1000 us apart, seq by one.
+  const auto& s = stack.sensors;
+  EXPECT_EQ(s[s.size() - 1].utime - s[s.size() - 2].utime, 1000);
+  EXPECT_EQ(s[s.size() - 1].seq - s[s.size() - 2].seq, 1);
+}
+
+std::vector<std::vector<uint8_t>> LockstepRun(int port) {
+  const std::string url = PrivateLcmUrl(port);
+  Stack stack(url, true);
+  Process sim({"--lcm-url", url, "--mode", "lockstep", "--duration", "0.5", "--seed", "11",
+               "--log-level", "warn"});
+  EXPECT_TRUE(sim.running());
+  stack.SpinUntilExit(&sim, 15.0);
+  EXPECT_EQ(sim.Wait(), 0);
+  EXPECT_EQ(stack.truth.size(), 501u);  // ticks 0..500 (t = 0 .. 0.5 s)
+  if (!stack.truth.empty()) {
+    EXPECT_EQ(stack.truth.front().utime, 0);
+    EXPECT_GT(stack.truth.back().q[2], Config().plant_sim.initial_pose(2) + 1e-3);  // it moved
+  }
+  return stack.truth_bytes;
+}
+
+TEST(PlantSimProcess, LockstepGivesByteIdenticalGroundTruth) {
+  const auto a = LockstepRun(7701);
+  const auto b = LockstepRun(7702);
+  ASSERT_EQ(a.size(), b.size());
+  for (size_t i = 0; i < a.size(); ++i) ASSERT_EQ(a[i], b[i]) << "tick " << i;
+}
+
+TEST(PlantSimProcess, LockstepTimeoutExitsNamingWhatItWaitedFor) {
+  std::ifstream in(DefaultConfigPath());
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string yaml = text.str();
+  const std::string key = "lockstep_timeout_s: ";
+  const size_t at = yaml.find(key);
+  ASSERT_NE(at, std::string::npos);
+  yaml.replace(at, yaml.find('\n', at) - at, key + "0.3");
+  const std::string path = ::testing::TempDir() + "plant_sim_timeout.yaml";
+  std::ofstream(path) << yaml;
+  const std::string url = PrivateLcmUrl(7703);
+  Stack stack(url, false);
+  Process sim({"--config", path, "--lcm-url", url, "--mode", "lockstep", "--duration", "1",
+               "--log-level", "warn"});
+  stack.SpinUntilExit(&sim, 10.0);
+  EXPECT_EQ(sim.Wait(), 3);
+  ASSERT_FALSE(stack.health.empty());
+  EXPECT_EQ(stack.health.back().state, static_cast<int8_t>(health_t::STATE_FAULT));
+  EXPECT_NE(stack.health.back().last_error.find("sample_utime 0"), std::string::npos)
+      << stack.health.back().last_error;
+  EXPECT_NE(stack.health.back().last_error.find(Config().lcm.channels.command_safe),
+            std::string::npos);
+}
+
+}  // namespace
+}  // namespace stewart

@@ -1,0 +1,16 @@
+#pragma once
+// Shared set-up of the plant_sim tests.
+#include <string>
+
+#include "stewart/config/stack_config.h"
+#include "stewart/plant_sim/plant.h"
+
+namespace stewart::test {
+
+const StackConfig& Config();
+PlantModel DefaultModel();
+OdeOptions OdeOptionsFor(const std::string& integrator);
+/// Leg forces that hold the platform at rest at pose q (N).
+Vector6d HoldingForce(const PlatformParams& platform, const Vector6d& q);
+
+}  // namespace stewart::test
