@@ -79,6 +79,10 @@ SafetyConfig ParseSafetyConfig(const ConfigNode& safety) {
   s.stale_age_s = safety.PositiveDouble("stale_age_s");
   s.fallback = safety.Choice("fallback", {"hold", "zero"}) == "hold" ? SafetyFallback::kHold
                                                                      : SafetyFallback::kZero;
+  if (const std::optional<double> stop = safety.OptionalDouble("stop_time_s")) {
+    if (!(*stop > 0.0)) safety.Fail("stop_time_s", "must be positive");
+    s.stop_time_s = *stop;
+  }
   return s;
 }
 

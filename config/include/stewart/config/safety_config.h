@@ -1,4 +1,5 @@
 #pragma once
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -42,6 +43,9 @@ struct SafetyConfig {
   bool force_limits_enabled = false;
   double stale_age_s = 0.02;
   SafetyFallback fallback = SafetyFallback::kHold;
+  /// Time constant of the "hold" safe stop: qdd = -qd / stop_time_s (s).
+  /// Optional key, default 0.2 s.
+  double stop_time_s = 0.2;
 };
 
 SafetyConfig ParseSafetyConfig(const ConfigNode& safety);

@@ -1,0 +1,132 @@
+// Per-step cost of the safety filter (docs/performance.md, "Safety filter").
+#include <benchmark/benchmark.h>
+
+#include <random>
+#include <vector>
+
+#include "stewart/config/stack_config.h"
+#include "stewart/safety/clp_reference_qp.h"
+#include "stewart/safety/safety_filter.h"
+#ifdef STEWART_HAVE_ALGLIB
+#include "stewart/safety/alglib_reference_qp.h"
+#endif
+
+namespace stewart::safety {
+namespace {
+
+const StackConfig& Config() {
+  static const StackConfig config = LoadStackConfig(DefaultConfigPath());
+  return config;
+}
+
+// A fixed set of states around home with nominal forces that make the filter
+// act often (every case occurs), cycled through by every benchmark.
+struct Sample {
+  Vector6d q, qd, f_des;
+  DynamicsTerms terms;
+};
+const std::vector<Sample>& Samples() {
+  static const std::vector<Sample> samples = [] {
+    std::vector<Sample> s;
+    std::mt19937 rng(5);
+    std::normal_distribution<double> n;
+    for (int i = 0; i < 256; ++i) {
+      Sample x;
+      x.q = Config().home_pose;
+      for (int j = 0; j < 3; ++j) x.q(j) += 0.03 * n(rng);
+      for (int j = 0; j < 6; ++j) x.qd(j) = 0.008 * n(rng);
+      x.terms = EvaluateDynamics(Config().platform, x.q, x.qd);
+      Vector6d qdd;
+      for (int j = 0; j < 6; ++j) qdd(j) = 2.0 * n(rng);
+      x.f_des = InverseDynamics(x.terms, qdd);
+      s.push_back(x);
+    }
+    return s;
+  }();
+  return samples;
+}
+
+void RunCore(benchmark::State& state, SafetyFilter* filter) {
+  SafetyDiagnostics d;
+  size_t i = 0;
+  for (auto _ : state) {
+    const Sample& s = Samples()[i++ & 255];
+    benchmark::DoNotOptimize(filter->StepWithTerms(s.terms, s.q, s.qd, s.f_des, &d));
+  }
+}
+
+// (a) the closed form given the model terms.
+void BM_ClosedFormCore(benchmark::State& state) {
+  SafetyFilter filter(Config().platform, Config().safety, Config().actuators);
+  RunCore(state, &filter);
+}
+BENCHMARK(BM_ClosedFormCore);
+
+// (b) the full step including M, C qd, G, H.
+void BM_ClosedFormFullStep(benchmark::State& state) {
+  SafetyFilter filter(Config().platform, Config().safety, Config().actuators);
+  SafetyDiagnostics d;
+  size_t i = 0;
+  for (auto _ : state) {
+    const Sample& s = Samples()[i++ & 255];
+    benchmark::DoNotOptimize(filter.Step(s.q, s.qd, s.f_des, &d));
+  }
+}
+BENCHMARK(BM_ClosedFormFullStep);
+
+void BM_PaperRuleCore(benchmark::State& state) {
+  SafetyConfig s = Config().safety;
+  s.variant = SafetyVariant::kPaperRule;
+  SafetyFilter filter(Config().platform, s, Config().actuators);
+  RunCore(state, &filter);
+}
+BENCHMARK(BM_PaperRuleCore);
+
+// (c) the QP reference, full step (model terms included, as (b)).
+template <typename Solver>
+void BM_QpReferenceFullStep(benchmark::State& state) {
+  Solver solver;
+  SafetyConfig s = Config().safety;
+  s.variant = SafetyVariant::kQpReference;
+  SafetyFilter filter(Config().platform, s, Config().actuators, &solver);
+  SafetyDiagnostics d;
+  size_t i = 0;
+  for (auto _ : state) {
+    const Sample& x = Samples()[i++ & 255];
+    benchmark::DoNotOptimize(filter.Step(x.q, x.qd, x.f_des, &d));
+  }
+}
+BENCHMARK_TEMPLATE(BM_QpReferenceFullStep, ClpReferenceQp);
+#ifdef STEWART_HAVE_ALGLIB
+BENCHMARK_TEMPLATE(BM_QpReferenceFullStep, AlglibReferenceQp);
+#endif
+
+// (d) the force-limited variant (exact dual active set), full step.
+void BM_ForceLimitedFullStep(benchmark::State& state) {
+  SafetyConfig s = Config().safety;
+  s.force_limits_enabled = true;
+  SafetyFilter filter(Config().platform, s, Config().actuators);
+  SafetyDiagnostics d;
+  size_t i = 0;
+  for (auto _ : state) {
+    const Sample& x = Samples()[i++ & 255];
+    benchmark::DoNotOptimize(filter.Step(x.q, x.qd, x.f_des, &d));
+  }
+}
+BENCHMARK(BM_ForceLimitedFullStep);
+
+void BM_ModelTermsOnly(benchmark::State& state) {
+  DynamicsTerms t;
+  size_t i = 0;
+  for (auto _ : state) {
+    const Sample& x = Samples()[i++ & 255];
+    EvaluateDynamics(Config().platform, x.q, x.qd, &t);
+    benchmark::DoNotOptimize(t);
+  }
+}
+BENCHMARK(BM_ModelTermsOnly);
+
+}  // namespace
+}  // namespace stewart::safety
+
+BENCHMARK_MAIN();

@@ -1,0 +1,38 @@
+#pragma once
+// Everything the filter computed at one step (maps 1:1 onto
+// stewart::safety_diagnostics_t, see diagnostics_lcm.h). Fixed-size storage.
+#include <array>
+#include <cstdint>
+
+#include "stewart/config/safety_config.h"
+#include "stewart/safety/barriers.h"
+#include "stewart/safety/two_constraint_qp.h"
+
+namespace stewart::safety {
+
+/// Bits of SafetyDiagnostics::flags; equal to force_command_t.FLAG_*.
+enum FilterFlag : std::int32_t {
+  kFlagFilterActive = 1,   ///< F* != F_des
+  kFlagInfeasible = 2,     ///< the QP had no solution; fallback applied
+  kFlagFallback = 4,       ///< the safe stop (last resort) was applied
+  kFlagInvalidInput = 16,  ///< non-finite or out-of-range q, qd or F_des
+  kFlagForceLimited = 64,  ///< an actuator force limit is active at F*
+};
+
+struct SafetyDiagnostics {
+  SafetyVariant variant = SafetyVariant::kClosedForm;
+  FilterCase filter_case = FilterCase::kNone;
+  bool infeasible = false;
+  std::int32_t flags = 0;  ///< FilterFlag bits
+  BarrierEvaluation barriers;
+  double mu_p = 0.0, mu_v = 0.0;
+  /// Force-limit multipliers, signed: + upper bound active, - lower.
+  /// F* = F_des + mu_p g_p + mu_v g_v - mu_force.
+  Vector6d mu_force = Vector6d::Zero();
+  Vector6d f_des = Vector6d::Zero();   ///< nominal force as received (N)
+  Vector6d f_safe = Vector6d::Zero();  ///< F* (N)
+  double correction_norm = 0.0;        ///< ||F* - F_des|| (N)
+  std::int64_t compute_ns = 0;
+};
+
+}  // namespace stewart::safety

@@ -1,0 +1,77 @@
+#pragma once
+// The CBF safety filter (docs/safety.md):
+//
+//   F* = argmin ||F - F_des||^2  s.t.  Psi_p(F) >= 0, Psi_v(F) >= 0
+//                                      [, |F_i| <= F_max]
+//
+// Typical use in a node (no heap allocation per step):
+//   SafetyFilter filter(config.platform, config.safety, config.actuators);
+//   SafetyDiagnostics diag;
+//   Vector6d f_safe = filter.Step(q, qd, f_des, &diag);
+#include "stewart/config/platform_config.h"
+#include "stewart/config/safety_config.h"
+#include "stewart/model/dynamics.h"
+#include "stewart/safety/constraint_set.h"
+#include "stewart/safety/diagnostics.h"
+#include "stewart/safety/reference_qp.h"
+
+namespace stewart::safety {
+
+/// |F_des_i| above this (N) is treated as invalid input, not filtered.
+constexpr double kMaxInputForceN = 1e7;
+
+class SafetyFilter {
+ public:
+  /// Throws std::invalid_argument for an unusable config, or variant "qp"
+  /// without a reference solver (which must outlive the filter).
+  SafetyFilter(const PlatformParams& platform, const SafetyConfig& safety,
+               const ActuatorConfig& actuators, ReferenceQpSolver* reference = nullptr);
+
+  /// Full step: evaluates the model terms at (q, qd), then StepWithTerms.
+  /// Output is always finite; see diagnostics->flags.
+  Vector6d Step(const Vector6d& q, const Vector6d& qd, const Vector6d& f_des,
+                SafetyDiagnostics* diagnostics);
+
+  /// The filter given the model terms at (q, qd) (from EvaluateDynamics).
+  Vector6d StepWithTerms(const DynamicsTerms& terms, const Vector6d& q, const Vector6d& qd,
+                         const Vector6d& f_des, SafetyDiagnostics* diagnostics) const;
+
+  /// The QP the filter solves at this step, as posed to the reference solver
+  /// (CBF rows scaled to unit normals; box rows when force limits are on).
+  /// Absent rows are left out; returns false when a CBF row has a zero
+  /// normal (it cannot be posed).
+  struct QpRows {
+    int p = -1, v = -1;          ///< row of each CBF condition, -1 if left out
+    int box = 0;                 ///< first force-limit row (lower, upper per leg)
+    bool drop_velocity = false;  ///< in: leave the velocity condition out
+  };
+  bool BuildQp(const BarrierEvaluation& barriers, const Vector6d& f_des, ProjectionQp* qp,
+               QpRows* rows = nullptr) const;
+
+  void set_variant(SafetyVariant variant);
+  SafetyVariant variant() const { return variant_; }
+  void set_force_limits(bool enabled) { force_limits_ = enabled; }
+  bool force_limits() const { return force_limits_; }
+  const ConstraintSet& constraints() const { return constraints_; }
+  double force_limit_n() const { return force_limit_n_; }
+
+ private:
+  Vector6d SafeStop(const DynamicsTerms& terms, const Vector6d& qd, bool terms_valid) const;
+  void SolveUnlimited(const BarrierEvaluation& b, SafetyDiagnostics* d) const;
+  void SolveForceLimited(const DynamicsTerms& terms, const Vector6d& qd, const BarrierEvaluation& b,
+                         const Vector6d& f_des, SafetyDiagnostics* d) const;
+  void SolveReference(const BarrierEvaluation& b, const Vector6d& f_des,
+                      SafetyDiagnostics* d) const;
+
+  PlatformParams platform_;
+  ConstraintSet constraints_;
+  SafetyVariant variant_;
+  bool force_limits_;
+  double force_limit_n_;
+  SafetyFallback fallback_;
+  double stop_time_s_;
+  ReferenceQpSolver* reference_;
+  DynamicsTerms terms_;  // scratch for Step
+};
+
+}  // namespace stewart::safety

@@ -1,0 +1,60 @@
+#pragma once
+// Closed-form solution of the filter's QP (NOTES.md, docs/safety.md):
+//
+//   min ||F - F_des||^2  s.t.  psi_i + g_i^T (F - F_des) >= 0,  i in {p, v}
+//
+// F* = F_des + mu_p g_p + mu_v g_v, mu >= 0. The exact KKT case analysis
+// tries the cases in order and returns the first whose KKT conditions hold;
+// the QP is strictly convex so, when feasible, exactly that one is optimal.
+#include <cstdint>
+
+#include "stewart/model/types.h"
+
+namespace stewart::safety {
+
+/// Case taken (values match safety_diagnostics_t.CASE_*).
+enum class FilterCase : std::int8_t {
+  kNone = 0,        ///< both conditions hold at F_des
+  kPosition = 1,    ///< only the position condition active
+  kVelocity = 2,    ///< only the velocity condition active
+  kBoth = 3,        ///< both active
+  kInfeasible = 4,  ///< the QP has no solution (reported by the solver)
+  kFallback = 5,    ///< invalid input: the safe stop was applied
+};
+
+/// The two affine conditions. An absent group (no constraint configured) is
+/// never active.
+struct TwoConstraintProblem {
+  double psi_p = 0.0, psi_v = 0.0;
+  Vector6d g_p = Vector6d::Zero(), g_v = Vector6d::Zero();
+  bool has_p = false, has_v = false;
+};
+
+struct TwoConstraintSolution {
+  double mu_p = 0.0, mu_v = 0.0;
+  FilterCase filter_case = FilterCase::kNone;
+  bool feasible = true;
+};
+
+/// A normal shorter than this (W/N = m/s for g_p) counts as zero: the
+/// condition cannot be changed by the force (e.g. g_p = -H^T qd at rest).
+constexpr double kZeroNormal = 1e-12;
+/// Gram determinant below this fraction of |g_p|^2 |g_v|^2 (sin^2 of the
+/// angle between the normals) counts as parallel normals.
+constexpr double kParallelSin2 = 1e-12;
+
+/// Exact KKT case analysis (cases 1-5 of NOTES.md).
+TwoConstraintSolution SolveExactKkt(const TwoConstraintProblem& problem);
+
+/// The paper's literal Theorem 1: the case is chosen by the signs of psi_p,
+/// psi_v at F_des alone, and its formula applied without the validity check.
+/// Not the QP solution in general (NOTES.md); kept to show the difference.
+/// Degenerate normals still give a defined (infeasible) answer.
+TwoConstraintSolution SolvePaperRule(const TwoConstraintProblem& problem);
+
+/// Lexicographic fallback for an infeasible problem: satisfy the position
+/// condition with the least correction (relaxing the velocity one), else the
+/// velocity condition alone; `feasible` stays false.
+TwoConstraintSolution SolveInfeasibleFallback(const TwoConstraintProblem& problem);
+
+}  // namespace stewart::safety

@@ -1,0 +1,51 @@
+// GPL-2+ component (ALGLIB): see alglib_reference_qp.h.
+#include "stewart/safety/alglib_reference_qp.h"
+
+#include <libalglib/optimization.h>
+
+namespace stewart::safety {
+
+ProjectionStatus AlglibReferenceQp::Solve(const ProjectionQp& qp, Vector6d* x) {
+  try {
+    alglib::real_2d_array quadratic;
+    quadratic.setlength(6, 6);
+    alglib::real_1d_array linear, scale;
+    linear.setlength(6);
+    scale.setlength(6);
+    for (int i = 0; i < 6; ++i) {
+      for (int j = 0; j < 6; ++j) quadratic[i][j] = i == j ? 1.0 : 0.0;
+      linear[i] = -qp.x0(i);
+      scale[i] = 1.0;
+    }
+    alglib::minqpstate state;
+    alglib::minqpcreate(6, state);
+    alglib::minqpsetquadraticterm(state, quadratic);
+    alglib::minqpsetlinearterm(state, linear);
+    alglib::minqpsetscale(state, scale);
+    if (qp.m > 0) {
+      alglib::real_2d_array c;
+      c.setlength(qp.m, 7);
+      alglib::integer_1d_array type;
+      type.setlength(qp.m);
+      for (int r = 0; r < qp.m; ++r) {
+        for (int i = 0; i < 6; ++i) c[r][i] = qp.a(r, i);
+        c[r][6] = qp.b(r);
+        type[r] = 1;  // >=
+      }
+      alglib::minqpsetlc(state, c, type);
+    }
+    alglib::minqpsetalgobleic(state, 0.0, 0.0, 0.0, 0);  // run to machine precision
+    alglib::minqpoptimize(state);
+    alglib::real_1d_array solution;
+    alglib::minqpreport report;
+    alglib::minqpresults(state, solution, report);
+    if (report.terminationtype == -3) return ProjectionStatus::kInfeasible;
+    if (report.terminationtype <= 0) return ProjectionStatus::kIterationLimit;
+    for (int i = 0; i < 6; ++i) (*x)(i) = solution[i];
+    return ProjectionStatus::kOptimal;
+  } catch (const alglib::ap_error&) {
+    return ProjectionStatus::kIterationLimit;
+  }
+}
+
+}  // namespace stewart::safety

@@ -1,0 +1,60 @@
+#include "stewart/safety/constraint_set.h"
+
+#include <stdexcept>
+
+namespace stewart::safety {
+namespace {
+
+void Require(bool ok, const std::string& what) {
+  if (!ok) throw std::invalid_argument("safety constraints: " + what);
+}
+
+}  // namespace
+
+ConstraintSet BuildConstraintSet(const PlatformParams& platform, const SafetyConfig& safety) {
+  ConstraintSet c;
+  Require(safety.k_position > 0.0 && safety.k_velocity > 0.0, "k must be positive");
+  c.k_position = safety.k_position;
+  c.k_velocity = safety.k_velocity;
+  auto add_position = [&](PositionSource source, int index, double sign, double limit,
+                          double alpha_e, double alpha, const std::string& name) {
+    Require(c.num_position < kMaxPositionBarriers, "too many position limits (axis listed twice?)");
+    Require(alpha_e > 0.0 && alpha > 0.0, name + ": alpha_e and alpha must be positive");
+    c.position[static_cast<size_t>(c.num_position++)] = {source,  index, sign, limit,
+                                                         alpha_e, alpha, name};
+  };
+  for (const PositionLimitConfig& l : safety.position_limits) {
+    const std::string axis(kAxisNames[static_cast<size_t>(l.axis)]);
+    if (l.lower)
+      add_position(PositionSource::kAxis, l.axis, 1.0, *l.lower, l.alpha_e, l.alpha,
+                   axis + "_lower");
+    if (l.upper)
+      add_position(PositionSource::kAxis, l.axis, -1.0, *l.upper, l.alpha_e, l.alpha,
+                   axis + "_upper");
+  }
+  if (safety.leg_stroke.enabled) {
+    const LegStrokeLimitConfig& s = safety.leg_stroke;
+    const double lower = platform.leg_min_length_m + s.margin_m;
+    const double upper = platform.leg_max_length_m - s.margin_m;
+    Require(lower < upper, "leg stroke margin leaves no stroke");
+    for (int i = 0; i < kNumLegs; ++i) {
+      const std::string leg = "leg" + std::to_string(i);
+      add_position(PositionSource::kLegLength, i, 1.0, lower, s.alpha_e, s.alpha, leg + "_lower");
+      add_position(PositionSource::kLegLength, i, -1.0, upper, s.alpha_e, s.alpha, leg + "_upper");
+    }
+  }
+  auto add_velocity = [&](int axis, double sign, double limit, double alpha_v,
+                          const std::string& name) {
+    Require(c.num_velocity < kMaxVelocityBarriers, "too many velocity limits (axis listed twice?)");
+    Require(alpha_v > 0.0, name + ": alpha_v must be positive");
+    c.velocity[static_cast<size_t>(c.num_velocity++)] = {axis, sign, limit, alpha_v, name};
+  };
+  for (const VelocityLimitConfig& l : safety.velocity_limits) {
+    const std::string axis = std::string(kAxisNames[static_cast<size_t>(l.axis)]) + "d";
+    if (l.lower) add_velocity(l.axis, 1.0, *l.lower, l.alpha_v, axis + "_lower");
+    if (l.upper) add_velocity(l.axis, -1.0, *l.upper, l.alpha_v, axis + "_upper");
+  }
+  return c;
+}
+
+}  // namespace stewart::safety

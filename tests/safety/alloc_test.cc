@@ -1,0 +1,71 @@
+// No heap allocation in the filter step: this binary replaces the global
+// operator new with a counting one.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cstdlib>
+#include <new>
+
+#include "safety_test_support.h"
+
+namespace {
+std::atomic<long> g_allocations{0};
+}  // namespace
+
+void* operator new(std::size_t size) {
+  g_allocations.fetch_add(1, std::memory_order_relaxed);
+  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
+  throw std::bad_alloc();
+}
+void* operator new[](std::size_t size) { return operator new(size); }
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete[](void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+
+namespace stewart::safety::test {
+namespace {
+
+long CountStepAllocations(bool force_limits, bool with_terms) {
+  SafetyConfig config = RichSafetyConfig();
+  config.force_limits_enabled = force_limits;
+  SafetyFilter filter(DefaultConfig().platform, config, DefaultConfig().actuators);
+  std::mt19937 rng(1);
+  std::vector<Vector6d> q, qd, f;
+  std::vector<DynamicsTerms> terms;
+  for (int i = 0; i < 500; ++i) {
+    q.push_back(RandomPoseInLimits(&rng));
+    qd.push_back(RandomVelocity(&rng));
+    terms.push_back(EvaluateDynamics(DefaultConfig().platform, q.back(), qd.back()));
+    f.push_back(RandomNominalForce(terms.back(), &rng));
+  }
+  f[0](0) = NAN;  // the fallback path too
+  SafetyDiagnostics d;
+  const long before = g_allocations.load();
+  for (int i = 0; i < 500; ++i) {
+    if (with_terms) {
+      filter.StepWithTerms(terms[static_cast<size_t>(i)], q[static_cast<size_t>(i)],
+                           qd[static_cast<size_t>(i)], f[static_cast<size_t>(i)], &d);
+    } else {
+      filter.Step(q[static_cast<size_t>(i)], qd[static_cast<size_t>(i)], f[static_cast<size_t>(i)],
+                  &d);
+    }
+  }
+  return g_allocations.load() - before;
+}
+
+TEST(Allocation, CounterWorks) {
+  const long before = g_allocations.load();
+  auto* p = new std::vector<int>(10);
+  delete p;
+  EXPECT_GE(g_allocations.load() - before, 2);
+}
+
+TEST(Allocation, CoreStepDoesNotAllocate) { EXPECT_EQ(CountStepAllocations(false, true), 0); }
+TEST(Allocation, FullStepDoesNotAllocate) { EXPECT_EQ(CountStepAllocations(false, false), 0); }
+TEST(Allocation, ForceLimitedStepDoesNotAllocate) {
+  EXPECT_EQ(CountStepAllocations(true, false), 0);
+}
+
+}  // namespace
+}  // namespace stewart::safety::test

@@ -1,0 +1,47 @@
+#include "stewart/safety/constraint_set.h"
+
+#include <gtest/gtest.h>
+
+#include <stdexcept>
+
+#include "safety_test_support.h"
+
+namespace stewart::safety::test {
+namespace {
+
+TEST(ConstraintSet, DefaultConfigIsThePapersUpperLimits) {
+  const ConstraintSet c = BuildConstraintSet(DefaultConfig().platform, DefaultConfig().safety);
+  EXPECT_EQ(c.num_position, 3);
+  EXPECT_EQ(c.num_velocity, 3);
+  EXPECT_EQ(c.position[2].name, "z_upper");
+  EXPECT_EQ(c.velocity[2].name, "zd_upper");
+  EXPECT_EQ(c.velocity[2].alpha_v, 2.0);
+}
+
+TEST(ConstraintSet, RichConfigHasEveryKind) {
+  const ConstraintSet c = BuildConstraintSet(DefaultConfig().platform, RichSafetyConfig());
+  EXPECT_EQ(c.num_position, 8 + 12);
+  EXPECT_EQ(c.num_velocity, 8);
+  EXPECT_EQ(c.position[0].name, "x_lower");
+  EXPECT_EQ(c.position[8].name, "leg0_lower");
+  EXPECT_EQ(c.position[8].source, PositionSource::kLegLength);
+  EXPECT_DOUBLE_EQ(c.position[9].limit, DefaultConfig().platform.leg_max_length_m - 0.005);
+}
+
+TEST(ConstraintSet, TooManyLimitsAreRejected) {
+  SafetyConfig s = RichSafetyConfig();
+  for (int i = 0; i < 3; ++i)
+    s.position_limits.insert(s.position_limits.end(), s.position_limits.begin(),
+                             s.position_limits.begin() + 4);
+  EXPECT_THROW(BuildConstraintSet(DefaultConfig().platform, s), std::invalid_argument);
+}
+
+TEST(ConstraintSet, QpVariantNeedsAReferenceSolver) {
+  SafetyConfig s = RichSafetyConfig();
+  s.variant = SafetyVariant::kQpReference;
+  EXPECT_THROW(SafetyFilter(DefaultConfig().platform, s, DefaultConfig().actuators),
+               std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace stewart::safety::test

@@ -1,0 +1,168 @@
+// Degenerate and hostile inputs: defined, finite output and a flag.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "safety_test_support.h"
+#include "stewart/safety/clp_reference_qp.h"
+#include "stewart/safety/two_constraint_qp.h"
+
+namespace stewart::safety::test {
+namespace {
+
+SafetyFilter MakeFilter(bool force_limits = false) {
+  SafetyConfig s = RichSafetyConfig();
+  s.force_limits_enabled = force_limits;
+  return SafetyFilter(DefaultConfig().platform, s, DefaultConfig().actuators);
+}
+
+Vector6d Hover(const Vector6d& q) {
+  const DynamicsTerms t = EvaluateDynamics(DefaultConfig().platform, q, Vector6d::Zero());
+  return t.H.partialPivLu().solve(t.G);
+}
+
+TEST(Degenerate, AtRestThePositionNormalIsZeroAndOnlyVelocityActs) {
+  // Upper limits only (the paper's set): with a lower and an upper limit on
+  // one axis at rest, their LSE weights are equal and their rates cancel
+  // (docs/safety.md), so the condition would not act at this instant.
+  SafetyFilter filter(DefaultConfig().platform, DefaultConfig().safety, DefaultConfig().actuators);
+  const Vector6d q = DefaultConfig().home_pose;
+  const DynamicsTerms t = EvaluateDynamics(DefaultConfig().platform, q, Vector6d::Zero());
+  // Accelerates along +x: the (then smallest-margin) xd limit must act.
+  const Vector6d f_des = InverseDynamics(t, Vector6d::Unit(0) * 20.0);
+  SafetyDiagnostics d;
+  const Vector6d f = filter.Step(q, Vector6d::Zero(), f_des, &d);
+  EXPECT_TRUE(f.allFinite());
+  EXPECT_EQ(d.barriers.g_p, Vector6d::Zero());
+  EXPECT_GT(d.barriers.h_pos, 0.0);
+  EXPECT_EQ(d.filter_case, FilterCase::kVelocity);
+  EXPECT_FALSE(d.infeasible);
+  EXPECT_EQ(d.mu_p, 0.0);
+}
+
+TEST(Degenerate, AtRestOutsideThePositionSetIsInfeasibleAndFlagged) {
+  SafetyFilter filter = MakeFilter();
+  Vector6d q = DefaultConfig().home_pose;
+  q(0) = 0.12;  // beyond x <= 0.11: h_pos < 0 and g_p = 0
+  SafetyDiagnostics d;
+  const Vector6d f = filter.Step(q, Vector6d::Zero(), Hover(q), &d);
+  EXPECT_TRUE(f.allFinite());
+  EXPECT_LT(d.barriers.psi_p, 0.0);
+  EXPECT_TRUE(d.infeasible);
+  EXPECT_TRUE(d.flags & kFlagInfeasible);
+  EXPECT_EQ(d.filter_case, FilterCase::kInfeasible);
+  // The velocity condition is still enforced by the fallback.
+  EXPECT_GE(d.barriers.psi_v + d.barriers.g_v.dot(f - Hover(q)), -1e-12);
+}
+
+TEST(Degenerate, ParallelNormals) {
+  TwoConstraintProblem p;
+  p.has_p = p.has_v = true;
+  p.g_p << 1, 2, 0, 0, 0, 0;
+  p.g_v = 3.0 * p.g_p;  // same direction: the tighter one binds
+  p.psi_p = -1.0;
+  p.psi_v = -6.0;
+  TwoConstraintSolution s = SolveExactKkt(p);
+  EXPECT_TRUE(s.feasible);
+  EXPECT_EQ(s.filter_case, FilterCase::kVelocity);
+  EXPECT_NEAR(p.psi_p + p.g_p.dot(s.mu_v * p.g_v), 1.0, 1e-12);
+
+  p.g_v = -p.g_p;  // opposite: a slab -psi_p <= g_p.d <= psi_v
+  p.psi_v = 2.0;
+  s = SolveExactKkt(p);
+  EXPECT_TRUE(s.feasible);
+  EXPECT_EQ(s.filter_case, FilterCase::kPosition);
+  p.psi_v = -0.5;  // empty slab
+  s = SolveExactKkt(p);
+  EXPECT_FALSE(s.feasible);
+  EXPECT_EQ(s.filter_case, FilterCase::kInfeasible);
+  // Fallback keeps the position condition exactly.
+  const TwoConstraintSolution fb = SolveInfeasibleFallback(p);
+  EXPECT_NEAR(p.psi_p + p.g_p.dot(fb.mu_p * p.g_p), 0.0, 1e-12);
+  EXPECT_FALSE(fb.feasible);
+}
+
+TEST(Degenerate, NearlyParallelNormalsStayFiniteAndMatchTheReference) {
+  for (double angle : {1e-3, 1e-5, 1e-7, 1e-9}) {
+    TwoConstraintProblem p;
+    p.has_p = p.has_v = true;
+    p.g_p << 1, 0, 0, 0, 0, 0;
+    p.g_v << std::cos(angle), std::sin(angle), 0, 0, 0, 0;
+    p.psi_p = -1.0;
+    p.psi_v = -1.0 - angle;  // both active for a non-degenerate angle
+    const TwoConstraintSolution s = SolveExactKkt(p);
+    const Vector6d d = s.mu_p * p.g_p + s.mu_v * p.g_v;
+    EXPECT_TRUE(d.allFinite());
+    if (s.feasible) {
+      EXPECT_GE(p.psi_p + p.g_p.dot(d), -1e-9);
+      EXPECT_GE(p.psi_v + p.g_v.dot(d), -1e-9 * (1 + d.norm()));
+    }
+  }
+}
+
+TEST(Degenerate, NanOrInfInAnyInputGivesTheFlaggedSafeStop) {
+  SafetyFilter filter = MakeFilter();
+  const Vector6d q = DefaultConfig().home_pose;
+  const Vector6d qd = Vector6d::Constant(0.001);
+  const Vector6d f_des = Hover(q);
+  for (double bad :
+       {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()}) {
+    for (int which = 0; which < 3; ++which) {
+      for (int i = 0; i < 6; ++i) {
+        Vector6d in[3] = {q, qd, f_des};
+        in[which](i) = bad;
+        SafetyDiagnostics d;
+        const Vector6d f = filter.Step(in[0], in[1], in[2], &d);
+        EXPECT_TRUE(f.allFinite()) << which << " " << i;
+        EXPECT_TRUE(d.flags & kFlagInvalidInput);
+        EXPECT_TRUE(d.flags & kFlagFallback);
+        EXPECT_EQ(d.filter_case, FilterCase::kFallback);
+        EXPECT_TRUE(std::isfinite(d.correction_norm));
+        EXPECT_TRUE(std::isfinite(d.barriers.psi_p) && std::isfinite(d.barriers.psi_v));
+        if (which == 2) {
+          // q, qd valid: the hold brake decelerates, qdd = -qd / stop_time.
+          const DynamicsTerms t = EvaluateDynamics(DefaultConfig().platform, q, qd);
+          EXPECT_LE((ForwardDynamics(t, f) + qd / DefaultConfig().safety.stop_time_s).norm(), 1e-9);
+        }
+      }
+    }
+  }
+}
+
+TEST(Degenerate, HugeNominalForce) {
+  SafetyFilter filter = MakeFilter();
+  const Vector6d q = DefaultConfig().home_pose;
+  SafetyDiagnostics d;
+  // Large but representable: filtered normally, strongly corrected.
+  Vector6d f = filter.Step(q, Vector6d::Constant(0.001), Vector6d::Constant(1e6), &d);
+  EXPECT_TRUE(f.allFinite());
+  EXPECT_FALSE(d.flags & kFlagInvalidInput);
+  EXPECT_TRUE(d.flags & kFlagFilterActive);
+  EXPECT_GE(d.barriers.psi_v + d.barriers.g_v.dot(f - d.f_des), -1e-9 * 1e6);
+  // Beyond kMaxInputForceN: rejected as invalid, safe stop.
+  f = filter.Step(q, Vector6d::Constant(0.001), Vector6d::Constant(1e300), &d);
+  EXPECT_TRUE(f.allFinite());
+  EXPECT_TRUE(d.flags & kFlagInvalidInput);
+  EXPECT_LT(f.norm(), 1e3);
+}
+
+TEST(Degenerate, ForceLimitsThatMakeTheConditionsInfeasibleAreReported) {
+  SafetyConfig s = RichSafetyConfig();
+  s.force_limits_enabled = true;
+  // Only a lower z velocity limit: falling violates it at once.
+  s.velocity_limits = {{2, -0.010, std::nullopt, 2.0}};
+  ActuatorConfig weak = DefaultConfig().actuators;
+  weak.force_limit_n = 0.5;  // cannot even hold the platform up
+  SafetyFilter filter(DefaultConfig().platform, s, weak);
+  const Vector6d q = DefaultConfig().home_pose;
+  SafetyDiagnostics d;
+  const Vector6d f = filter.Step(q, Vector6d::Zero(), Hover(q), &d);
+  EXPECT_TRUE(f.allFinite());
+  EXPECT_TRUE(d.infeasible);
+  EXPECT_TRUE(d.flags & kFlagInfeasible);
+  EXPECT_LE(f.cwiseAbs().maxCoeff(), 0.5 + 1e-12);
+}
+
+}  // namespace
+}  // namespace stewart::safety::test

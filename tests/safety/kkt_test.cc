@@ -1,0 +1,67 @@
+// KKT conditions checked directly on the filter's output, for the closed
+// form and for the force-limited variant, on random states.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "safety_test_support.h"
+
+namespace stewart::safety::test {
+namespace {
+
+void CheckKkt(bool force_limits) {
+  SafetyConfig config = RichSafetyConfig();
+  config.force_limits_enabled = force_limits;
+  SafetyFilter filter(DefaultConfig().platform, config, DefaultConfig().actuators);
+  const double f_max = DefaultConfig().actuators.force_limit_n;
+  std::mt19937 rng(force_limits ? 23 : 29);
+  int checked = 0, active = 0;
+  for (int n = 0; n < 5000; ++n) {
+    const Vector6d q = RandomPoseInLimits(&rng);
+    const Vector6d qd = RandomVelocity(&rng);
+    const DynamicsTerms terms = EvaluateDynamics(DefaultConfig().platform, q, qd);
+    const Vector6d f_des = RandomNominalForce(terms, &rng);
+    SafetyDiagnostics d;
+    const Vector6d f = filter.StepWithTerms(terms, q, qd, f_des, &d);
+    ASSERT_TRUE(f.allFinite());
+    if (d.infeasible) continue;
+    ++checked;
+    if (d.mu_p > 0 || d.mu_v > 0) ++active;
+    const BarrierEvaluation& b = d.barriers;
+    const double scale = f.norm() + f_des.norm() + 1.0;
+    // Stationarity.
+    const Vector6d residual = f - f_des - d.mu_p * b.g_p - d.mu_v * b.g_v + d.mu_force;
+    EXPECT_LE(residual.norm(), 1e-10 * scale) << "sample " << n;
+    // Dual feasibility.
+    EXPECT_GE(d.mu_p, 0.0);
+    EXPECT_GE(d.mu_v, 0.0);
+    // Primal feasibility and complementary slackness, per condition.
+    const double psi_p = b.psi_p + b.g_p.dot(f - f_des);
+    const double psi_v = b.psi_v + b.g_v.dot(f - f_des);
+    const double tol_p = 1e-10 * (std::fabs(b.psi_p) + b.g_p.norm() * scale);
+    const double tol_v = 1e-10 * (std::fabs(b.psi_v) + b.g_v.norm() * scale);
+    EXPECT_GE(psi_p, -tol_p) << "sample " << n;
+    EXPECT_GE(psi_v, -tol_v) << "sample " << n;
+    EXPECT_LE(std::fabs(d.mu_p * psi_p), d.mu_p * tol_p + 1e-300) << "sample " << n;
+    EXPECT_LE(std::fabs(d.mu_v * psi_v), d.mu_v * tol_v + 1e-300) << "sample " << n;
+    if (force_limits) {
+      for (int i = 0; i < 6; ++i) {
+        EXPECT_LE(std::fabs(f(i)), f_max * (1 + 1e-12));
+        if (d.mu_force(i) > 0) {
+          EXPECT_NEAR(f(i), f_max, 1e-9 * f_max);
+        }
+        if (d.mu_force(i) < 0) {
+          EXPECT_NEAR(f(i), -f_max, 1e-9 * f_max);
+        }
+      }
+    }
+  }
+  EXPECT_GT(checked, 4000);
+  EXPECT_GT(active, 1000);
+}
+
+TEST(Kkt, ClosedForm) { CheckKkt(false); }
+TEST(Kkt, ForceLimited) { CheckKkt(true); }
+
+}  // namespace
+}  // namespace stewart::safety::test

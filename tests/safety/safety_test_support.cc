@@ -1,0 +1,82 @@
+#include "safety_test_support.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "stewart/model/kinematics.h"
+
+namespace stewart::safety::test {
+
+const StackConfig& DefaultConfig() {
+  static const StackConfig config = LoadStackConfig(DefaultConfigPath());
+  return config;
+}
+
+SafetyConfig RichSafetyConfig() {
+  SafetyConfig s = DefaultConfig().safety;
+  s.variant = SafetyVariant::kClosedForm;
+  s.position_limits = {
+      {0, -0.08, 0.11, 1.0, 1.0},
+      {1, -0.10, 0.11, 1.5, 0.8},
+      {2, 0.36, 0.51, 1.0, 1.2},
+      {3, -0.15, 0.15, 0.5, 2.0},
+  };
+  s.velocity_limits = {
+      {0, -0.015, 0.015, 1.0},
+      {1, -0.015, 0.015, 1.0},
+      {2, -0.010, 0.010, 2.0},
+      {5, -0.10, 0.10, 1.5},
+  };
+  s.leg_stroke.enabled = true;
+  s.leg_stroke.margin_m = 0.005;
+  s.leg_stroke.alpha_e = 2.0;
+  s.leg_stroke.alpha = 1.0;
+  s.force_limits_enabled = false;
+  return s;
+}
+
+Vector6d RandomPoseInLimits(std::mt19937* rng) {
+  std::uniform_real_distribution<double> x(-0.08, 0.11), y(-0.10, 0.11), z(0.36, 0.51);
+  std::uniform_real_distribution<double> phi(-0.15, 0.15), angle(-0.2, 0.2);
+  const PlatformParams& p = DefaultConfig().platform;
+  const double margin = RichSafetyConfig().leg_stroke.margin_m;
+  for (;;) {
+    Vector6d q;
+    q << x(*rng), y(*rng), z(*rng), phi(*rng), angle(*rng), angle(*rng);
+    const Vector6d l = InverseKinematics(p, q);
+    if (PoseInWorkspace(p, q) && l.minCoeff() > p.leg_min_length_m + margin &&
+        l.maxCoeff() < p.leg_max_length_m - margin) {
+      return q;
+    }
+  }
+}
+
+namespace {
+double LogUniform(std::mt19937* rng, double lo, double hi) {
+  std::uniform_real_distribution<double> u(std::log(lo), std::log(hi));
+  return std::exp(u(*rng));
+}
+Vector6d RandomDirection(std::mt19937* rng) {
+  std::normal_distribution<double> n;
+  Vector6d v;
+  for (int i = 0; i < 6; ++i) v(i) = n(*rng);
+  return v.normalized();
+}
+}  // namespace
+
+Vector6d RandomVelocity(std::mt19937* rng) {
+  Vector6d qd = RandomDirection(rng) * LogUniform(rng, 1e-4, 3e-2);
+  qd.tail<3>() *= 3.0;  // rad/s: rotations are a bit faster
+  return qd;
+}
+
+Vector6d RandomNominalForce(const DynamicsTerms& terms, std::mt19937* rng) {
+  const Vector6d qdd = RandomDirection(rng) * LogUniform(rng, 1e-3, 10.0);
+  return InverseDynamics(terms, qdd);
+}
+
+double RelativeError(const Vector6d& a, const Vector6d& b) {
+  return (a - b).norm() / std::max(b.norm(), 1.0);
+}
+
+}  // namespace stewart::safety::test
