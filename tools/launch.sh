@@ -1,33 +1,184 @@
 #!/usr/bin/env bash
-# The main job. Until every process of the stack exists, it builds what
-# exists, evaluates the model on the paper's scenario, and says what is
-# still missing.
+# Starts the stack: plant (plant_sim, or hw_bridge with --plant hw), estimator,
+# controller and safety, with one config and one scenario, on a private LCM
+# URL. With no arguments: the simulated stack on the paper's scenario, in
+# lockstep, recorded, with a report. See docs/operations.md.
 set -euo pipefail
-cd "$(dirname "$0")/.."
+ROOT=$(cd "$(dirname "$0")/.." && pwd)
+cd "$ROOT"
+
+usage() {
+  cat <<USAGE
+usage: tools/launch.sh [options]
+  --plant sim|hw        simulator (default) or the hardware bridge
+  --device-emulator     with --plant hw: also start the device emulator (no real device)
+  --lockstep            plant and stack step together (default for sim)
+  --realtime            wall-clock paced at the sensor rate (default for hw)
+  --scenario NAME|FILE  config/scenarios/NAME.yaml (default: paper)
+  --config FILE         stack config (default: config/platform.yaml)
+  --variant V           safety filter: closed_form | paper | qp (default: from config)
+  --duration S          simulated seconds (default: the scenario's duration)
+  --log FILE            record every channel with lcm-logger (default: <run>/log.lcm)
+  --no-log              do not record (no report either)
+  --no-report           record, but do not write the report
+  --spy                 also open lcm-spy on the run's URL
+  --lcm-url URL         use this URL instead of a private one
+  --out DIR             run folder (default: runs/<date>-<scenario>)
+USAGE
+}
+
+PLANT=sim MODE="" SCENARIO=paper CONFIG="$ROOT/config/platform.yaml" VARIANT="" DURATION=""
+LOG="" DO_LOG=1 DO_REPORT=1 SPY=0 URL="" OUT="" EMULATOR=0
+while (($#)); do
+  case "$1" in
+    --plant) PLANT=$2; shift ;;
+    --device-emulator) EMULATOR=1 ;;
+    --lockstep) MODE=lockstep ;;
+    --realtime) MODE=realtime ;;
+    --scenario) SCENARIO=$2; shift ;;
+    --config) CONFIG=$(realpath "$2"); shift ;;
+    --variant) VARIANT=$2; shift ;;
+    --duration) DURATION=$2; shift ;;
+    --log) LOG=$(realpath -m "$2"); shift ;;
+    --no-log) DO_LOG=0; DO_REPORT=0 ;;
+    --no-report) DO_REPORT=0 ;;
+    --spy) SPY=1 ;;
+    --lcm-url) URL=$2; shift ;;
+    --out) OUT=$(realpath -m "$2"); shift ;;
+    -h|--help) usage; exit 0 ;;
+    *) echo "launch: unknown option '$1'" >&2; usage >&2; exit 2 ;;
+  esac
+  shift
+done
+[[ $PLANT == sim || $PLANT == hw ]] || { echo "launch: --plant sim|hw" >&2; exit 2; }
+[[ -n $MODE ]] || { [[ $PLANT == sim ]] && MODE=lockstep || MODE=realtime; }
+if [[ $PLANT == hw && $MODE == lockstep ]]; then
+  echo "launch: the real device cannot step in lockstep; use --realtime" >&2; exit 2
+fi
+
 tools/setup.sh >/dev/null
-BUILD_DIR=${STEWART_BUILD_DIR:-build}
+BUILD=${STEWART_BUILD_DIR:-$ROOT/build}
+bin() { # path of a built program, or fail naming it
+  local p
+  p=$(find "$BUILD" -maxdepth 3 -type f -name "$1" -perm -u+x -print -quit)
+  [[ -n $p ]] || { echo "launch: program '$1' is not built in $BUILD" >&2; exit 1; }
+  echo "$p"
+}
+PLANT_SIM=$(bin plant_sim) ESTIMATOR=$(bin estimator) CONTROLLER=$(bin controller)
+SAFETY=$(bin safety) MONITOR=$(bin stewart_stack_monitor)
 
-echo "== Stewart platform stack =="
-missing=()
-for proc in plant_sim estimator controller safety hw_bridge; do
-  bin=$(find "$BUILD_DIR" -maxdepth 3 -type f -name "$proc" -perm -u+x 2>/dev/null | head -n 1)
-  if [[ -n "$bin" ]]; then echo "built:   $proc ($bin)"; else echo "missing: $proc"; missing+=("$proc"); fi
+[[ -n $DURATION ]] || DURATION=$("$CONTROLLER" --config "$CONFIG" --scenario "$SCENARIO" --print-duration)
+STAMP=$(date +%Y%m%d-%H%M%S)
+[[ -n $OUT ]] || OUT="$ROOT/runs/$STAMP-$(basename "$SCENARIO" .yaml)"
+mkdir -p "$OUT"
+[[ -n $LOG ]] || LOG="$OUT/log.lcm"
+if [[ -z $URL ]]; then
+  # A private multicast port per run (ttl=0: nothing leaves this machine).
+  URL="udpm://239.255.76.67:$((20000 + RANDOM % 20000))?ttl=0"
+fi
+COMMON=(--config "$CONFIG" --lcm-url "$URL")
+
+# Everything needed to reproduce the run sits beside the log.
+cp "$CONFIG" "$OUT/config.yaml"
+if [[ -f $SCENARIO ]]; then cp "$SCENARIO" "$OUT/scenario.yaml"
+else cp "$ROOT/config/scenarios/$SCENARIO.yaml" "$OUT/scenario.yaml"; fi
+{
+  echo "git_revision: $(git rev-parse HEAD 2>/dev/null || echo unknown)$(git diff --quiet 2>/dev/null || echo '-dirty')"
+  echo "started: $STAMP"
+  echo "plant: $PLANT"
+  echo "mode: $MODE"
+  echo "scenario: $SCENARIO"
+  echo "duration_s: $DURATION"
+  echo "variant: ${VARIANT:-from config}"
+  echo "lcm_url: $URL"
+  echo "command: tools/launch.sh $*"
+} > "$OUT/run.yaml"
+
+echo "== Stewart stack: $PLANT, $MODE, scenario '$SCENARIO' ($DURATION s) =="
+echo "   run folder: $OUT"
+echo "   LCM URL:    $URL"
+echo "   process logs: $OUT/<process>.log"
+
+PIDS=() NAMES=()
+start() { # name, command...
+  local name=$1; shift
+  "$@" >"$OUT/$name.log" 2>&1 &
+  PIDS+=($!) NAMES+=("$name")
+}
+stop_all() {
+  local pid
+  for pid in "${PIDS[@]}"; do kill -TERM "$pid" 2>/dev/null || true; done
+  for _ in $(seq 30); do
+    local alive=0
+    for pid in "${PIDS[@]}"; do kill -0 "$pid" 2>/dev/null && alive=1; done
+    ((alive)) || return 0
+    sleep 0.1
+  done
+  for pid in "${PIDS[@]}"; do kill -KILL "$pid" 2>/dev/null || true; done
+}
+fail() { # name of the process that died
+  echo "launch: '$1' exited unexpectedly; its last log lines:" >&2
+  tail -n 15 "$OUT/$1.log" >&2 || true
+  stop_all
+  exit 1
+}
+trap 'echo; echo "launch: interrupted, stopping every process"; stop_all; exit 130' INT TERM
+
+if ((DO_LOG)); then
+  # lcm-logger 1.3.1: '-l URL' is rejected, use --lcm-url=URL.
+  start logger lcm-logger --lcm-url="$URL" -f "$LOG"
+  echo "   recording:  $LOG"
+fi
+if ((SPY)); then start lcm-spy "$ROOT/tools/lcm-spy" --lcm-url="$URL"; fi
+
+SAFETY_ARGS=("${COMMON[@]}")
+[[ -z $VARIANT ]] || SAFETY_ARGS+=(--variant "$VARIANT")
+start safety "$SAFETY" "${SAFETY_ARGS[@]}"
+start controller "$CONTROLLER" "${COMMON[@]}" --scenario "$SCENARIO"
+start estimator "$ESTIMATOR" "${COMMON[@]}"
+"$MONITOR" "${COMMON[@]}" --wait-for safety,controller,estimator --timeout 15 ||
+  { echo "launch: the stack did not come up" >&2; for n in safety controller estimator; do tail -n 5 "$OUT/$n.log" >&2; done; stop_all; exit 1; }
+
+if [[ $PLANT == sim ]]; then
+  start plant_sim "$PLANT_SIM" "${COMMON[@]}" --mode "$MODE" --duration "$DURATION"
+  PLANT_NAME=plant_sim
+else
+  if ((EMULATOR)); then start hw_emulator "$(bin hw_emulator)" --config "$CONFIG"; fi
+  start hw_bridge "$(bin hw_bridge)" "${COMMON[@]}"
+  PLANT_NAME=hw_bridge
+fi
+start monitor "$MONITOR" "${COMMON[@]}" --progress-of "$DURATION"
+MONITOR_LOG="$OUT/monitor.log"
+
+# Wait for the plant to finish the scenario; fail fast if anything dies.
+now() { date +%s.%N; }
+elapsed() { awk -v a="$1" -v b="$(now)" 'BEGIN { printf "%.3f", b - a }'; }
+T0=$(now)
+LAST_PROGRESS=""
+while :; do
+  for i in "${!PIDS[@]}"; do
+    name=${NAMES[$i]} pid=${PIDS[$i]}
+    if ! kill -0 "$pid" 2>/dev/null; then
+      status=0; wait "$pid" || status=$?
+      if [[ $name == "$PLANT_NAME" && $status -eq 0 ]]; then break 2; fi
+      [[ $name == monitor || $name == lcm-spy ]] && continue
+      fail "$name"
+    fi
+  done
+  if [[ $PLANT == hw ]] && awk -v e="$(elapsed "$T0")" -v d="$DURATION" 'BEGIN { exit !(e > d + 1) }'; then
+    break
+  fi
+  line=$(tail -n 1 "$MONITOR_LOG" 2>/dev/null || true)
+  if [[ -n $line && $line != "$LAST_PROGRESS" ]]; then echo "$line"; LAST_PROGRESS=$line; fi
+  sleep 0.5
 done
+WALL=$(elapsed "$T0")
+sleep 0.5  # let the logger flush the last messages
+stop_all
+trap - INT TERM
+printf "== done: %s s simulated in %.1f s wall ==\n" "$DURATION" "$WALL"
+echo "wall_time_s: $WALL" >> "$OUT/run.yaml"
 
-echo
-echo "== model at the paper's setpoints (leg lengths, m; holding forces, N) =="
-for q in "0 0 0.4 0 0 0" "0.1 0 0.4 0 0 0" "0 0.1 0.4 0 0 0" "0 0 0.45 0 0 0" "0 0 0.5 0 0 0"; do
-  # shellcheck disable=SC2086
-  "$BUILD_DIR/tools/stewart_model_tool" --q $q | /usr/bin/python3 -c '
-import json, sys
-r = json.load(sys.stdin)
-fmt = lambda v: " ".join("%7.4f" % x for x in v)
-print("q=[%s]  legs [%s]  in stroke: %s  F_hold [%s]" % (fmt(r["q"][:3]), fmt(r["leg_length_m"]),
-      r["in_stroke"], fmt(r["inverse_dynamics_F"])))'
-done
-
-if ((${#missing[@]})); then
-  echo
-  echo "The closed-loop stack cannot run yet: missing ${missing[*]}."
-  exit 0
+if ((DO_REPORT)); then
+  "$ROOT/tools/report.sh" "$OUT"
 fi

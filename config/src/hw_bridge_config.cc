@@ -1,21 +1,73 @@
 #include "stewart/config/hw_bridge_config.h"
 
+#include <cmath>
+
 namespace stewart {
 
 HwBridgeConfig ParseHwBridgeConfig(const ConfigNode& hw_bridge) {
   HwBridgeConfig h;
   h.transport = hw_bridge.Choice("transport", {"udp", "serial"});
   h.device_host = hw_bridge.String("device_host");
-  h.device_port = hw_bridge.Int("device_port");
-  h.local_port = hw_bridge.Int("local_port");
+  h.local_host = hw_bridge.String("local_host");
   for (const char* key : {"device_port", "local_port"}) {
     const int port = hw_bridge.Int(key);
     if (port < 0 || port > 65535) hw_bridge.Fail(key, "must be a UDP port 0..65535");
   }
+  h.device_port = hw_bridge.Int("device_port");
+  h.local_port = hw_bridge.Int("local_port");
   h.serial_device = hw_bridge.String("serial_device");
   h.serial_baud = hw_bridge.Int("serial_baud");
   if (h.serial_baud <= 0) hw_bridge.Fail("serial_baud", "must be positive");
   h.command_timeout_s = hw_bridge.PositiveDouble("command_timeout_s");
+  h.device_watchdog_s = hw_bridge.PositiveDouble("device_watchdog_s");
+  // The frame carries the watchdog in whole microseconds, 1 ms .. 1 s.
+  if (h.device_watchdog_s < 1e-3 || h.device_watchdog_s > 1.0) {
+    hw_bridge.Fail("device_watchdog_s", "must be within [0.001, 1] s");
+  }
+  h.link_timeout_s = hw_bridge.PositiveDouble("link_timeout_s");
+  h.late_frame_s = hw_bridge.PositiveDouble("late_frame_s");
+  h.clock_drift_ppm = hw_bridge.NonNegativeDouble("clock_drift_ppm");
+
+  h.adc_max_count = hw_bridge.Int("adc_max_count");
+  if (h.adc_max_count < 1 || h.adc_max_count > 65535) {
+    hw_bridge.Fail("adc_max_count", "must be within [1, 65535] (uint16 on the wire)");
+  }
+  h.adc_fault_margin_counts = hw_bridge.Int("adc_fault_margin_counts");
+  if (h.adc_fault_margin_counts < 0) hw_bridge.Fail("adc_fault_margin_counts", "must be >= 0");
+  h.adc_retracted = hw_bridge.Vec6("adc_retracted");
+  h.adc_extended = hw_bridge.Vec6("adc_extended");
+  for (int i = 0; i < 6; ++i) {
+    const double lo = h.adc_retracted(i);
+    const double hi = h.adc_extended(i);
+    if (lo < 0 || lo > h.adc_max_count) {
+      hw_bridge.Fail("adc_retracted", "leg " + std::to_string(i) + " outside [0, adc_max_count]");
+    }
+    if (hi < 0 || hi > h.adc_max_count) {
+      hw_bridge.Fail("adc_extended", "leg " + std::to_string(i) + " outside [0, adc_max_count]");
+    }
+    // A reversed pot is allowed (hi < lo), a degenerate span is not.
+    if (std::abs(hi - lo) < 100.0) {
+      hw_bridge.Fail("adc_extended",
+                     "leg " + std::to_string(i) + ": span to adc_retracted below 100 counts");
+    }
+  }
+  h.length_offset_m = hw_bridge.Vec6("length_offset_m");
+
+  h.gyro_radps_per_lsb = hw_bridge.PositiveDouble("gyro_radps_per_lsb");
+  h.accel_mps2_per_lsb = hw_bridge.PositiveDouble("accel_mps2_per_lsb");
+
+  h.force_at_full_duty_n = hw_bridge.PositiveDouble("force_at_full_duty_n");
+  h.duty_deadband = hw_bridge.NonNegativeDouble("duty_deadband");
+  if (h.duty_deadband >= 1.0) hw_bridge.Fail("duty_deadband", "must be < 1");
+  h.force_deadzone_n = hw_bridge.NonNegativeDouble("force_deadzone_n");
+  h.max_duty = hw_bridge.PositiveDouble("max_duty");
+  if (h.max_duty > 1.0) hw_bridge.Fail("max_duty", "must be <= 1");
+  h.drive_sign = hw_bridge.Vec6("drive_sign");
+  for (int i = 0; i < 6; ++i) {
+    if (h.drive_sign(i) != 1.0 && h.drive_sign(i) != -1.0) {
+      hw_bridge.Fail("drive_sign", "leg " + std::to_string(i) + ": must be 1 or -1");
+    }
+  }
   return h;
 }
 

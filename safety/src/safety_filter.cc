@@ -127,6 +127,18 @@ Vector6d SafetyFilter::StepWithTerms(const DynamicsTerms& terms, const Vector6d&
   return d->f_safe;
 }
 
+Vector6d SafetyFilter::SafeStopCommand(const Vector6d& q, const Vector6d& qd,
+                                       SafetyDiagnostics* d) {
+  *d = SafetyDiagnostics{};
+  d->variant = variant_;
+  const bool state_valid = q.allFinite() && qd.allFinite();
+  if (state_valid) EvaluateDynamics(platform_, q, qd, &terms_);
+  d->filter_case = FilterCase::kFallback;
+  d->flags = kFlagFallback;
+  d->f_safe = SafeStop(terms_, qd, state_valid && terms_.M.allFinite());
+  return d->f_safe;
+}
+
 Vector6d SafetyFilter::SafeStop(const DynamicsTerms& terms, const Vector6d& qd,
                                 bool terms_valid) const {
   Vector6d f = Vector6d::Zero();

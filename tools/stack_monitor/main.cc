@@ -6,12 +6,12 @@
 //                                             second: simulated time of the
 //                                             newest sensor sample, filter
 //                                             activity, rejections
-#include <CLI/CLI.hpp>
-#include <lcm/lcm-cpp.hpp>
 #include <spdlog/spdlog.h>
 
+#include <CLI/CLI.hpp>
 #include <chrono>
 #include <cstdio>
+#include <lcm/lcm-cpp.hpp>
 #include <map>
 #include <set>
 #include <sstream>
@@ -45,7 +45,9 @@ class Monitor {
 
   bool Seen(const std::string& name) const { return health_.count(name) > 0; }
   double SimTime() const {
-    return first_sample_utime_ < 0 ? 0.0 : 1e-6 * static_cast<double>(newest_sample_utime_ - first_sample_utime_);
+    return first_sample_utime_ < 0
+               ? 0.0
+               : 1e-6 * static_cast<double>(newest_sample_utime_ - first_sample_utime_);
   }
   std::string Summary() const {
     std::ostringstream s;

@@ -36,6 +36,11 @@ class SafetyFilter {
   Vector6d StepWithTerms(const DynamicsTerms& terms, const Vector6d& q, const Vector6d& qd,
                          const Vector6d& f_des, SafetyDiagnostics* diagnostics) const;
 
+  /// The configured safe stop at (q, qd), for when no usable nominal command
+  /// exists (stale or missing): flagged kFlagFallback, case kFallback. Zero
+  /// force if the state itself is not finite.
+  Vector6d SafeStopCommand(const Vector6d& q, const Vector6d& qd, SafetyDiagnostics* diagnostics);
+
   /// The QP the filter solves at this step, as posed to the reference solver
   /// (CBF rows scaled to unit normals; box rows when force limits are on).
   /// Absent rows are left out; returns false when a CBF row has a zero

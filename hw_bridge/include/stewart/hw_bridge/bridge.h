@@ -1,0 +1,122 @@
+#pragma once
+// The host side of the device link, without LCM: sensor frames -> SI
+// samples in the stack's time base, safe force commands -> command frames,
+// with the command watchdog and the link statistics. hw_bridge_main wires it
+// to LCM and a Transport.
+#include <cstddef>
+#include <cstdint>
+
+#include "stewart/config/hw_bridge_config.h"
+#include "stewart/hw_bridge/calibration.h"
+#include "stewart/hw_bridge/drive_map.h"
+#include "stewart/hw_bridge/link_stats.h"
+#include "stewart/hw_bridge/wire_format.h"
+#include "stewart/model/types.h"
+
+namespace stewart::hw {
+
+/// One sample in SI units; the node copies it into sensor_t.
+struct SensorSample {
+  int64_t utime = 0;  ///< host time base (us), DeviceClockMap
+  int64_t seq = 0;    ///< device frame seq
+  Vector6d leg_length_m = Vector6d::Zero();
+  Vector3d gyro_radps = Vector3d::Zero();
+  Vector3d accel_mps2 = Vector3d::Zero();
+  int32_t status = 0;  ///< sensor_t.STATUS_* bits
+};
+
+/// Why the last command frame carried what it carried.
+enum class DriveReason {
+  kCommand,  ///< the latest safe command, mapped
+  kMissing,  ///< no valid command received yet: zero drive
+  kStale,    ///< the held command is older than command_timeout_s: zero drive
+  kInvalid,  ///< the latest command was non-finite: zero drive
+};
+const char* ToString(DriveReason reason);
+
+enum class CommandVerdict {
+  kAccepted,
+  kNonFinite,   ///< NaN/Inf force: rejected, zero drive until a valid one
+  kOutOfOrder,  ///< older than the held command: ignored
+  kFuture,      ///< newer than the newest sample by more than the timeout:
+                ///< another time base (a second stack?), ignored
+};
+const char* ToString(CommandVerdict verdict);
+
+struct BridgeCounters {
+  uint64_t sensor_frames = 0;
+  uint64_t lost_frames = 0;       ///< sensor seq gaps
+  uint64_t late_frames = 0;       ///< arrived > late_frame_s after the sample time
+  uint64_t reordered_frames = 0;  ///< seq not newer than the last: dropped
+  uint64_t leg_fault_samples = 0;
+  uint64_t imu_fault_samples = 0;
+  uint64_t device_watchdog_samples = 0;
+  uint64_t command_frames = 0;
+  uint64_t commands_accepted = 0;
+  uint64_t zero_drive_frames = 0;  ///< frames sent with zero drive for a DriveReason != kCommand
+  uint64_t force_clamped = 0;      ///< legs clamped to the force limit (frames x legs)
+  uint64_t duty_clamped = 0;
+  uint64_t device_rx_corrupt = 0;  ///< the device's own counters (latest)
+  uint64_t device_rx_lost = 0;
+  WindowStats rtt_us;    ///< command round trip, per health window
+  WindowStats delay_us;  ///< host arrival - sample utime, per health window
+};
+
+class HwBridge {
+ public:
+  HwBridge(const HwBridgeConfig& hw, double min_length_m, double stroke_m, double force_limit_n);
+
+  /// A decoded sensor frame that arrived at host_rx_us. Returns false (and
+  /// counts) when it must not be published: duplicate or reordered.
+  bool OnSensorFrame(const SensorFrame& frame, int64_t host_rx_us, SensorSample* sample);
+
+  /// A safe command (force_command_t.utime, force_n).
+  CommandVerdict OnForceCommand(int64_t utime, const Vector6d& force_n);
+
+  /// True when a sensor frame arrived and no command frame went out since
+  /// the previous one: the keep-alive frame of this tick is due.
+  bool TickFrameDue() const { return tick_frame_due_; }
+
+  /// Encodes the next command frame into out (kMaxFrameSize bytes) and
+  /// remembers its send time for the round trip.
+  std::size_t BuildCommandFrame(int64_t host_now_us, uint8_t* out);
+
+  DriveReason last_reason() const { return last_reason_; }
+  /// No sensor frame for link_timeout_s (or none yet).
+  bool LinkDown(int64_t host_now_us) const;
+  int64_t latest_sample_utime() const { return latest_sample_utime_; }
+  uint16_t last_device_status() const { return last_device_status_; }
+  const BridgeCounters& counters() const { return counters_; }
+  void ResetWindows() {
+    counters_.rtt_us.Reset();
+    counters_.delay_us.Reset();
+  }
+
+ private:
+  DriveReason CurrentReason() const;
+
+  HwBridgeConfig hw_;
+  LegCalibration calibration_;
+  ImuScale imu_;
+  DriveMap drive_map_;
+  DeviceClockMap clock_;
+  RoundTripTracker rtt_;
+  BridgeCounters counters_;
+
+  bool have_sample_ = false;
+  uint32_t last_sample_seq_ = 0;
+  int64_t latest_sample_utime_ = 0;
+  int64_t last_rx_host_us_ = 0;
+  uint16_t last_device_status_ = 0;
+  bool tick_frame_due_ = false;
+  bool sent_since_sample_ = false;
+
+  bool have_command_ = false;
+  bool command_invalid_ = false;
+  int64_t command_utime_ = 0;
+  Vector6d command_force_n_ = Vector6d::Zero();
+  uint32_t next_command_seq_ = 1;
+  DriveReason last_reason_ = DriveReason::kMissing;
+};
+
+}  // namespace stewart::hw

@@ -1,0 +1,161 @@
+#include "stewart/hw_bridge/bridge.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace stewart::hw {
+namespace {
+constexpr int32_t kSensorStatusMask = 0x1F;  // DeviceStatus bits 0..4 = sensor_t.STATUS_*
+}
+
+const char* ToString(DriveReason reason) {
+  switch (reason) {
+    case DriveReason::kCommand:
+      return "command";
+    case DriveReason::kMissing:
+      return "missing";
+    case DriveReason::kStale:
+      return "stale";
+    case DriveReason::kInvalid:
+      return "invalid";
+  }
+  return "unknown";
+}
+
+const char* ToString(CommandVerdict verdict) {
+  switch (verdict) {
+    case CommandVerdict::kAccepted:
+      return "accepted";
+    case CommandVerdict::kNonFinite:
+      return "non_finite_command";
+    case CommandVerdict::kOutOfOrder:
+      return "out_of_order_command";
+    case CommandVerdict::kFuture:
+      return "future_command";
+  }
+  return "unknown";
+}
+
+HwBridge::HwBridge(const HwBridgeConfig& hw, double min_length_m, double stroke_m,
+                   double force_limit_n)
+    : hw_(hw),
+      calibration_(hw, min_length_m, stroke_m),
+      imu_(hw),
+      drive_map_(hw, force_limit_n),
+      clock_(hw.clock_drift_ppm) {}
+
+bool HwBridge::OnSensorFrame(const SensorFrame& frame, int64_t host_rx_us, SensorSample* sample) {
+  if (have_sample_) {
+    // Signed difference so a wrapping uint32 seq still orders correctly.
+    const auto gap = static_cast<int32_t>(frame.seq - last_sample_seq_);
+    if (gap <= 0) {
+      ++counters_.reordered_frames;
+      return false;
+    }
+    counters_.lost_frames += static_cast<uint64_t>(gap - 1);
+  }
+  ++counters_.sensor_frames;
+  last_rx_host_us_ = host_rx_us;
+  last_device_status_ = frame.status;
+
+  int64_t utime = clock_.Map(frame.device_time_us, host_rx_us);
+  // A first frame that was delayed more than a sample period lets the
+  // offset drop by more than one period later; never publish time backwards.
+  if (have_sample_) utime = std::max(utime, latest_sample_utime_ + 1);
+  const int64_t delay_us = host_rx_us - utime;
+  counters_.delay_us.Add(delay_us);
+  if (delay_us > static_cast<int64_t>(hw_.late_frame_s * 1e6)) ++counters_.late_frames;
+
+  sample->utime = utime;
+  sample->seq = frame.seq;
+  sample->status = frame.status & kSensorStatusMask;
+  bool leg_fault = frame.leg_fault_mask != 0;
+  for (int i = 0; i < kNumLegs; ++i) {
+    const uint16_t adc = frame.adc[static_cast<std::size_t>(i)];
+    leg_fault = leg_fault || !calibration_.Plausible(i, adc);
+    sample->leg_length_m(i) = calibration_.LengthM(i, adc);
+  }
+  if (leg_fault) {
+    sample->status |= kStatusLegFault;
+    ++counters_.leg_fault_samples;
+  }
+  sample->gyro_radps = imu_.GyroRadps(frame.gyro_raw);
+  sample->accel_mps2 = imu_.AccelMps2(frame.accel_raw);
+  if (ImuScale::Saturated(frame.gyro_raw) || ImuScale::Saturated(frame.accel_raw)) {
+    sample->status |= kStatusImuFault;
+  }
+  if ((sample->status & kStatusImuFault) != 0) ++counters_.imu_fault_samples;
+  if ((frame.status & kStatusWatchdog) != 0) ++counters_.device_watchdog_samples;
+  counters_.device_rx_corrupt = frame.rx_corrupt;
+  counters_.device_rx_lost = frame.rx_lost;
+
+  int64_t rtt_us = 0;
+  if (rtt_.OnEcho(frame.last_command_seq, frame.command_age_us, host_rx_us, &rtt_us)) {
+    counters_.rtt_us.Add(rtt_us);
+  }
+
+  have_sample_ = true;
+  last_sample_seq_ = frame.seq;
+  latest_sample_utime_ = utime;
+  tick_frame_due_ = !sent_since_sample_;
+  sent_since_sample_ = false;
+  return true;
+}
+
+CommandVerdict HwBridge::OnForceCommand(int64_t utime, const Vector6d& force_n) {
+  if (!force_n.allFinite()) {
+    command_invalid_ = true;
+    return CommandVerdict::kNonFinite;
+  }
+  const auto timeout_us = static_cast<int64_t>(hw_.command_timeout_s * 1e6);
+  if (!have_sample_ || utime > latest_sample_utime_ + timeout_us) return CommandVerdict::kFuture;
+  if (have_command_ && utime < command_utime_) return CommandVerdict::kOutOfOrder;
+  have_command_ = true;
+  command_invalid_ = false;
+  command_utime_ = utime;
+  command_force_n_ = force_n;
+  ++counters_.commands_accepted;
+  return CommandVerdict::kAccepted;
+}
+
+DriveReason HwBridge::CurrentReason() const {
+  if (command_invalid_) return DriveReason::kInvalid;
+  if (!have_command_) return DriveReason::kMissing;
+  // Age in stack time: how far the device's samples have moved on since the
+  // sample this command was computed from.
+  const double age_s = static_cast<double>(latest_sample_utime_ - command_utime_) * 1e-6;
+  if (age_s > hw_.command_timeout_s) return DriveReason::kStale;
+  return DriveReason::kCommand;
+}
+
+std::size_t HwBridge::BuildCommandFrame(int64_t host_now_us, uint8_t* out) {
+  CommandFrame frame;
+  frame.seq = next_command_seq_++;
+  frame.watchdog_us = static_cast<uint32_t>(std::lround(hw_.device_watchdog_s * 1e6));
+  frame.flags = kCommandEnable;
+  last_reason_ = CurrentReason();
+  if (last_reason_ == DriveReason::kCommand) {
+    const DriveResult drive = drive_map_.ForceToDrive(command_force_n_);
+    frame.drive = drive.drive;
+    for (int i = 0; i < kNumLegs; ++i) {
+      counters_.force_clamped += (drive.force_clamped_mask >> i) & 1U;
+      counters_.duty_clamped += (drive.duty_clamped_mask >> i) & 1U;
+    }
+  } else {
+    // Zero drive: the P-16P's lead screw holds its length unpowered.
+    frame.drive.fill(0);
+    ++counters_.zero_drive_frames;
+  }
+  ++counters_.command_frames;
+  rtt_.OnSent(frame.seq, host_now_us);
+  sent_since_sample_ = true;
+  tick_frame_due_ = false;
+  return EncodeCommandFrame(frame, out);
+}
+
+bool HwBridge::LinkDown(int64_t host_now_us) const {
+  if (!have_sample_) return true;
+  return static_cast<double>(host_now_us - last_rx_host_us_) * 1e-6 > hw_.link_timeout_s;
+}
+
+}  // namespace stewart::hw

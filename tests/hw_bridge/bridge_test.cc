@@ -1,0 +1,195 @@
+#include "stewart/hw_bridge/bridge.h"
+
+#include <gtest/gtest.h>
+
+#include "test_config.h"
+
+namespace stewart::hw {
+namespace {
+
+class BridgeTest : public ::testing::Test {
+ protected:
+  BridgeTest()
+      : hw_(test::Config().hw_bridge),
+        bridge_(hw_, 0.385, 0.2, test::Config().actuators.force_limit_n) {}
+
+  // A device sample: seq k taken at device time k ms, arriving `delay_us` later
+  // on a host clock whose epoch is 1e12 us.
+  bool Deliver(uint32_t k, int64_t delay_us = 100, uint32_t echo_seq = 0, uint32_t age_us = 0) {
+    SensorFrame f;
+    f.seq = k;
+    f.device_time_us = 1000ULL * k;
+    f.adc.fill(2000);
+    f.accel_raw = {0, 0, 8192};
+    f.last_command_seq = echo_seq;
+    f.command_age_us = age_us;
+    host_now_ = kHostEpoch + 1000 * static_cast<int64_t>(k) + delay_us;
+    return bridge_.OnSensorFrame(f, host_now_, &sample_);
+  }
+
+  DecodedFrame Send() {
+    std::array<uint8_t, kMaxFrameSize> buf{};
+    const std::size_t n = bridge_.BuildCommandFrame(host_now_, buf.data());
+    DecodedFrame out;
+    EXPECT_EQ(DecodeDatagram(buf.data(), n, &out), DecodeStatus::kOk);
+    return out;
+  }
+
+  static constexpr int64_t kHostEpoch = 1'000'000'000'000;
+  HwBridgeConfig hw_;
+  HwBridge bridge_;
+  SensorSample sample_;
+  int64_t host_now_ = 0;
+};
+
+TEST_F(BridgeTest, SampleInSiUnitsOnTheHostTimeBase) {
+  ASSERT_TRUE(Deliver(0, 300));
+  ASSERT_TRUE(Deliver(1, 100));
+  const LegCalibration cal(hw_, 0.385, 0.2);
+  EXPECT_DOUBLE_EQ(sample_.leg_length_m(3), cal.LengthM(3, 2000));
+  EXPECT_NEAR(sample_.accel_mps2.z(), 9.81, 0.01);
+  EXPECT_EQ(sample_.status, 0);
+  // Offset = least observed delay (100 us) -> utime = host time of sampling + 100.
+  EXPECT_EQ(sample_.utime, kHostEpoch + 1000 + 100);
+  ASSERT_TRUE(Deliver(2, 2000));  // a slow frame does not move the mapping
+  EXPECT_EQ(sample_.utime, kHostEpoch + 2000 + 100);
+}
+
+TEST_F(BridgeTest, CountsLostLateAndReorderedFrames) {
+  Deliver(0);
+  Deliver(1);
+  Deliver(5);  // 2, 3, 4 lost
+  EXPECT_EQ(bridge_.counters().lost_frames, 3U);
+  EXPECT_FALSE(Deliver(4));  // late arrival of an old one: dropped, not published
+  EXPECT_FALSE(Deliver(5));  // duplicate
+  EXPECT_EQ(bridge_.counters().reordered_frames, 2U);
+  Deliver(6, 100 + static_cast<int64_t>(hw_.late_frame_s * 1e6) + 1);
+  EXPECT_EQ(bridge_.counters().late_frames, 1U);
+  EXPECT_EQ(bridge_.counters().sensor_frames, 4U);
+}
+
+TEST_F(BridgeTest, MissingCommandGivesZeroDrive) {
+  Deliver(0);
+  const DecodedFrame f = Send();
+  EXPECT_EQ(bridge_.last_reason(), DriveReason::kMissing);
+  for (int16_t d : f.command.drive) EXPECT_EQ(d, 0);
+  EXPECT_EQ(f.command.watchdog_us, static_cast<uint32_t>(hw_.device_watchdog_s * 1e6));
+  EXPECT_EQ(bridge_.counters().zero_drive_frames, 1U);
+}
+
+TEST_F(BridgeTest, FreshCommandIsMappedAndStaleOneZeroed) {
+  Deliver(0);
+  Deliver(1);
+  const Vector6d force = Vector6d::Constant(20.0);
+  ASSERT_EQ(bridge_.OnForceCommand(sample_.utime, force), CommandVerdict::kAccepted);
+  DecodedFrame f = Send();
+  EXPECT_EQ(bridge_.last_reason(), DriveReason::kCommand);
+  const DriveResult expected = DriveMap(hw_, 100.0).ForceToDrive(force);
+  EXPECT_EQ(f.command.drive, expected.drive);
+  // The stack's time moves on (new samples) but no new command: stale after
+  // command_timeout_s of sample time, whatever the wall clock does.
+  const auto timeout_ms = static_cast<uint32_t>(hw_.command_timeout_s * 1e3);
+  Deliver(1 + timeout_ms);
+  f = Send();
+  EXPECT_EQ(bridge_.last_reason(), DriveReason::kCommand);
+  Deliver(2 + timeout_ms);
+  f = Send();
+  EXPECT_EQ(bridge_.last_reason(), DriveReason::kStale);
+  for (int16_t d : f.command.drive) EXPECT_EQ(d, 0);
+}
+
+TEST_F(BridgeTest, NonFiniteCommandZeroesUntilAValidOne) {
+  Deliver(0);
+  ASSERT_EQ(bridge_.OnForceCommand(sample_.utime, Vector6d::Constant(10.0)),
+            CommandVerdict::kAccepted);
+  Vector6d bad = Vector6d::Constant(10.0);
+  bad(4) = std::nan("");
+  EXPECT_EQ(bridge_.OnForceCommand(sample_.utime, bad), CommandVerdict::kNonFinite);
+  DecodedFrame f = Send();
+  EXPECT_EQ(bridge_.last_reason(), DriveReason::kInvalid);
+  for (int16_t d : f.command.drive) EXPECT_EQ(d, 0);
+  ASSERT_EQ(bridge_.OnForceCommand(sample_.utime, Vector6d::Constant(10.0)),
+            CommandVerdict::kAccepted);
+  f = Send();
+  EXPECT_EQ(bridge_.last_reason(), DriveReason::kCommand);
+  EXPECT_GT(f.command.drive[0], 0);
+}
+
+TEST_F(BridgeTest, CommandsFromAnotherTimeBaseOrOutOfOrderAreIgnored) {
+  EXPECT_EQ(bridge_.OnForceCommand(5, Vector6d::Zero()), CommandVerdict::kFuture);  // no sample
+  Deliver(0);
+  Deliver(1);
+  EXPECT_EQ(bridge_.OnForceCommand(sample_.utime + 10'000'000, Vector6d::Zero()),
+            CommandVerdict::kFuture);
+  ASSERT_EQ(bridge_.OnForceCommand(sample_.utime, Vector6d::Constant(5.0)),
+            CommandVerdict::kAccepted);
+  EXPECT_EQ(bridge_.OnForceCommand(sample_.utime - 1000, Vector6d::Constant(50.0)),
+            CommandVerdict::kOutOfOrder);
+  EXPECT_EQ(Send().command.drive, DriveMap(hw_, 100.0).ForceToDrive(Vector6d::Constant(5.0)).drive);
+}
+
+TEST_F(BridgeTest, OneKeepAliveFramePerTickWithoutCommands) {
+  Deliver(0);
+  EXPECT_TRUE(bridge_.TickFrameDue());
+  Send();
+  EXPECT_FALSE(bridge_.TickFrameDue());
+  Deliver(1);
+  EXPECT_FALSE(bridge_.TickFrameDue());  // a frame went out during the last period
+  Deliver(2);
+  EXPECT_TRUE(bridge_.TickFrameDue());
+}
+
+TEST_F(BridgeTest, RoundTripExcludesTheDeviceHoldTime) {
+  Deliver(0);
+  const DecodedFrame f = Send();  // sent at host_now_
+  const int64_t sent_at = host_now_;
+  // Echoed with the frame of sample 3, held 400 us by the device.
+  Deliver(3, 100, f.command.seq, 400);
+  EXPECT_EQ(bridge_.counters().rtt_us.count, 1);
+  EXPECT_EQ(bridge_.counters().rtt_us.last, host_now_ - sent_at - 400);
+  Deliver(4, 100, f.command.seq, 1400);  // the same seq again: not a new sample
+  EXPECT_EQ(bridge_.counters().rtt_us.count, 1);
+}
+
+TEST_F(BridgeTest, ImplausibleAdcAndSaturatedImuAreFlagged) {
+  SensorFrame f;
+  f.seq = 0;
+  f.adc.fill(2000);
+  f.adc[2] = 0;
+  f.gyro_raw = {32767, 0, 0};
+  ASSERT_TRUE(bridge_.OnSensorFrame(f, kHostEpoch, &sample_));
+  EXPECT_NE(sample_.status & kStatusLegFault, 0);
+  EXPECT_NE(sample_.status & kStatusImuFault, 0);
+  EXPECT_TRUE(sample_.leg_length_m.allFinite());
+}
+
+TEST_F(BridgeTest, LinkDownAfterTimeout) {
+  EXPECT_TRUE(bridge_.LinkDown(kHostEpoch));
+  Deliver(0);
+  EXPECT_FALSE(bridge_.LinkDown(host_now_ + 1000));
+  EXPECT_TRUE(bridge_.LinkDown(host_now_ + static_cast<int64_t>(hw_.link_timeout_s * 1e6) + 1));
+}
+
+TEST(DeviceClockMap, TracksDriftWithinTheBoundAndResetsOnReboot) {
+  DeviceClockMap map(200.0);
+  // Device clock 100 ppm slow: host advances 1.0001 ms per device ms.
+  int64_t last = 0;
+  for (int k = 0; k < 20000; ++k) {
+    const uint64_t d = 1000ULL * static_cast<uint64_t>(k);
+    const auto h = static_cast<int64_t>(1e9 + 1.0001 * static_cast<double>(d)) + 50 + (k % 7) * 30;
+    const int64_t u = map.Map(d, h);
+    EXPECT_LE(u, h);  // never later than the arrival
+    if (k > 0) {
+      EXPECT_GT(u, last);
+    }
+    last = u;
+    if (k > 100) {
+      EXPECT_GE(u, h - 50 - 6 * 30 - 5);  // follows the drift
+    }
+  }
+  map.Map(5, 2'000'000'000);
+  EXPECT_EQ(map.resets(), 1U);
+}
+
+}  // namespace
+}  // namespace stewart::hw

@@ -1,0 +1,12 @@
+#pragma once
+#include "stewart/config/stack_config.h"
+
+namespace stewart::hw::test {
+
+/// The project's config file: tests use the shipped calibration and map.
+inline const StackConfig& Config() {
+  static const StackConfig config = LoadStackConfig(DefaultConfigPath());
+  return config;
+}
+
+}  // namespace stewart::hw::test

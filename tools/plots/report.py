@@ -1,0 +1,152 @@
+#!/usr/bin/python3
+"""Report of one run of the stack (tools/launch.sh): limits against ground
+truth, filter activity, filter compute time, sensor-to-command latency, and
+the paper's Fig. 5 equivalent. Reads <run>/csv/*.csv, <run>/config.yaml.
+
+Usage: tools/plots/report.py RUN_FOLDER    (Debian's /usr/bin/python3)
+"""
+import csv
+import os
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+import yaml  # noqa: E402
+
+AXES = ["x", "y", "z", "phi", "theta", "psi"]
+CASES = {0: "none", 1: "position", 2: "velocity", 3: "both", 4: "infeasible", 5: "fallback"}
+
+
+def load(run, channel_key, config):
+    lcm = config["lcm"]
+    name = lcm["channel_prefix"] + lcm["channels"][channel_key] + (lcm.get("channel_suffix") or "")
+    path = os.path.join(run, "csv", name + ".csv")
+    if not os.path.exists(path):
+        return None
+    with open(path) as f:
+        rows = list(csv.DictReader(f))
+    if not rows:
+        return None
+    return {k: np.array([float(r[k]) for r in rows]) for k in rows[0]
+            if k not in ("name", "counters", "last_error")}
+
+
+def percentile(values, p):
+    return float(np.percentile(values, p)) if len(values) else float("nan")
+
+
+def main():
+    run = sys.argv[1]
+    with open(os.path.join(run, "config.yaml")) as f:
+        config = yaml.safe_load(f)
+    truth = load(run, "state_truth", config)
+    est = load(run, "state_estimate", config)
+    diag = load(run, "safety_diagnostics", config)
+    sensors = load(run, "sensors", config)
+    safe = load(run, "command_safe", config)
+    setpoint = load(run, "setpoint", config)
+    state = truth if truth is not None else est
+    source = "ground truth (STATE_TRUE)" if truth is not None else "estimate (STATE_EST)"
+    t0 = state["utime_us"][0]
+    t = (state["utime_us"] - t0) * 1e-6
+    safety = config["safety"]
+    lines = ["# Run report", ""]
+    run_yaml = os.path.join(run, "run.yaml")
+    if os.path.exists(run_yaml):
+        lines += ["```", open(run_yaml).read().strip(), "```", ""]
+
+    lines += [f"## Limits, measured on {source}", "",
+              "| constraint | limit | max reached | exceeded by |", "| --- | --- | --- | --- |"]
+    exceeded = []
+    for kind, key, unit in (("position", "q", "m"), ("velocity", "qd", "m/s")):
+        for limit in safety[f"{kind}_limits"]:
+            axis = limit["axis"]
+            col = f"{key}_{axis}_" + ({"q": "m", "qd": "mps"}[key] if AXES.index(axis) < 3 else
+                                      {"q": "rad", "qd": "radps"}[key])
+            values = state[col]
+            for side in ("upper", "lower"):
+                if side not in limit:
+                    continue
+                bound = limit[side]
+                reached = values.max() if side == "upper" else values.min()
+                over = (reached - bound) if side == "upper" else (bound - reached)
+                lines.append(f"| {axis} {kind} {side} | {bound:g} {unit} | {reached:.5f} | "
+                             f"{max(over, 0.0):.2e} |")
+                if over > 0:
+                    exceeded.append(f"{axis} {kind} {side}")
+    lines += ["", "Exceeded: " + (", ".join(exceeded) if exceeded else "none"), ""]
+
+    if diag is not None:
+        dt = np.median(np.diff(diag["utime_us"])) * 1e-6 if len(diag["utime_us"]) > 1 else 0.0
+        lines += ["## Filter activity", "", "| case | steps | time (s) |", "| --- | --- | --- |"]
+        for code, name in CASES.items():
+            n = int(np.sum(diag["active_case"] == code))
+            if n:
+                lines.append(f"| {name} | {n} | {n * dt:.2f} |")
+        ns = diag["compute_ns"]
+        lines += ["", f"Filter compute time per step: p50 {percentile(ns, 50) / 1e3:.2f} us, "
+                  f"p99 {percentile(ns, 99) / 1e3:.2f} us, max {ns.max() / 1e3:.2f} us "
+                  f"({len(ns)} steps).", ""]
+
+    if sensors is not None and safe is not None:
+        # Log receive times of a sample and of the safe command derived from it.
+        sample_rx = dict(zip(sensors["sample_utime_us"], sensors["log_utime_us"]))
+        lat = [rx - sample_rx[s] for s, rx in zip(safe["sample_utime_us"], safe["log_utime_us"])
+               if s in sample_rx]
+        lat = np.array(lat)
+        lines += ["## Sensor-to-command latency", "",
+                  f"From the logger's receive time of a sensor sample to that of the safe "
+                  f"command derived from it: p50 {percentile(lat, 50):.0f} us, p99 "
+                  f"{percentile(lat, 99):.0f} us, max {lat.max():.0f} us over {len(lat)} "
+                  f"commands; {len(sensors['seq']) - len(lat)} samples had no safe command.", ""]
+
+    fig, axes = plt.subplots(4, 3, figsize=(14, 11), sharex=True)
+    limits = {(l["axis"], kind): l for kind in ("position", "velocity")
+              for l in safety[f"{kind}_limits"]}
+    for j, axis in enumerate(AXES[:3]):
+        ax = axes[0, j]
+        ax.plot(t, state[f"q_{axis}_m"], label=f"{axis}")
+        if setpoint is not None:
+            ax.plot((setpoint["utime_us"] - t0) * 1e-6, setpoint[f"q_des_{axis}_m"], "--",
+                    lw=0.8, label=f"{axis}_des")
+        if (axis, "position") in limits and "upper" in limits[(axis, "position")]:
+            ax.axhline(limits[(axis, "position")]["upper"], color="r", lw=0.8, label="limit")
+        ax.set_ylabel(f"{axis} (m)")
+        ax.legend(fontsize=7)
+        ax = axes[1, j]
+        ax.plot(t, state[f"qd_{axis}_mps"])
+        if (axis, "velocity") in limits and "upper" in limits[(axis, "velocity")]:
+            ax.axhline(limits[(axis, "velocity")]["upper"], color="r", lw=0.8)
+        ax.set_ylabel(f"d{axis}/dt (m/s)")
+    if diag is not None:
+        td = (diag["utime_us"] - t0) * 1e-6
+        for i in range(6):
+            axes[2, i % 3].plot(td, diag[f"f_safe{i}_n"], lw=0.8, label=f"F*{i}")
+            axes[2, i % 3].plot(td, diag[f"f_des{i}_n"], lw=0.6, ls=":", label=f"F_des{i}")
+        for j in range(3):
+            axes[2, j].set_ylabel("leg force (N)")
+            axes[2, j].legend(fontsize=6, ncol=2)
+        axes[3, 0].plot(td, diag["active_case"], lw=0.8)
+        axes[3, 0].set_yticks(list(CASES))
+        axes[3, 0].set_yticklabels(list(CASES.values()), fontsize=7)
+        axes[3, 0].set_ylabel("filter case")
+        axes[3, 1].plot(td, diag["correction_norm_n"], lw=0.8)
+        axes[3, 1].set_ylabel("||F* - F_des|| (N)")
+        axes[3, 2].plot(td, diag["compute_ns"] / 1e3, lw=0.5)
+        axes[3, 2].set_ylabel("filter time (us)")
+    for ax in axes[-1]:
+        ax.set_xlabel("t (s)")
+    fig.suptitle(f"Fig. 5 equivalent: {os.path.basename(os.path.normpath(run))}")
+    fig.tight_layout()
+    fig.savefig(os.path.join(run, "fig5.png"), dpi=100)
+    lines += ["## Plots", "", "![Fig. 5 equivalent](fig5.png)", ""]
+    with open(os.path.join(run, "report.md"), "w") as f:
+        f.write("\n".join(lines))
+    print("\n".join(lines[:40]))
+
+
+if __name__ == "__main__":
+    main()
