@@ -1,0 +1,147 @@
+// The real safety process over LCM: a nominal command is filtered and
+// answered with the same sample_utime; when nominal commands stop (the
+// controller died), each new state is answered with the flagged fallback.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+
+#include <chrono>
+#include <string>
+#include <vector>
+
+#include "stewart/config/stack_config.h"
+#include "stewart/force_command_t.hpp"
+#include "stewart/model/dynamics.h"
+#include "stewart/node/eigen_msg.h"
+#include "stewart/node/lcm_handle.h"
+#include "stewart/state_t.hpp"
+
+extern char** environ;
+
+namespace stewart {
+namespace {
+
+constexpr int kPort = 7810;  // this test's private LCM port
+
+class SafeSink {
+ public:
+  void OnSafe(const lcm::ReceiveBuffer*, const std::string&, const force_command_t* msg) {
+    received.push_back(*msg);
+  }
+  std::vector<force_command_t> received;
+};
+
+class SafetyProcess {
+ public:
+  explicit SafetyProcess(const std::string& url) {
+    std::vector<std::string> args = {SAFETY_PATH, "--lcm-url", url, "--log-level", "warn"};
+    std::vector<char*> argv;
+    for (auto& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    EXPECT_EQ(posix_spawn(&pid_, SAFETY_PATH, nullptr, nullptr, argv.data(), environ), 0);
+  }
+  ~SafetyProcess() {
+    kill(pid_, SIGTERM);
+    int status = 0;
+    waitpid(pid_, &status, 0);
+  }
+
+ private:
+  pid_t pid_ = 0;
+};
+
+state_t MakeState(int64_t utime, const Vector6d& q) {
+  state_t s{};
+  s.utime = utime;
+  s.seq = utime / 1000;
+  s.sample_utime = utime;
+  ToArray(q, s.q);
+  s.status = state_t::STATUS_VALID;
+  return s;
+}
+
+bool WaitFor(lcm::LCM* lcm, const SafeSink& sink, std::size_t count) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(5);
+  while (sink.received.size() < count && std::chrono::steady_clock::now() < deadline) {
+    lcm->handleTimeout(50);
+  }
+  return sink.received.size() >= count;
+}
+
+TEST(SafetyProcess, FiltersNominalAndFallsBackWhenControllerStops) {
+  const StackConfig config = LoadStackConfig(DefaultConfigPath());
+  const std::string url = PrivateLcmUrl(kPort);
+  auto lcm = MakeLcm(url);
+  SafeSink sink;
+  lcm->subscribe(config.lcm.channels.command_safe, &SafeSink::OnSafe, &sink);
+  SafetyProcess process(url);
+  // Give the process time to subscribe: resend the first state until the
+  // first answer (the fallback: no nominal command has arrived yet).
+  int64_t utime = 1'000'000;
+  const Vector6d q = config.home_pose;
+  for (int attempt = 0; attempt < 50 && sink.received.empty(); ++attempt) {
+    const state_t s = MakeState(utime, q);
+    lcm->publish(config.lcm.channels.state_estimate, &s);
+    lcm->handleTimeout(100);
+    utime += 1000;
+  }
+  ASSERT_FALSE(sink.received.empty()) << "safety process never answered";
+  EXPECT_TRUE(sink.received.back().flags & force_command_t::FLAG_FALLBACK);
+
+  // Controller alive: state then nominal (the gravity-holding force at rest
+  // violates nothing), answered unchanged with the same sample_utime.
+  const Vector6d f_hold =
+      InverseDynamics(EvaluateDynamics(config.platform, q, Vector6d::Zero()), Vector6d::Zero());
+  // The first pair only shows the controller is alive: its state came before
+  // any nominal command existed, so it was answered by the fallback already.
+  for (int k = 0; k < 11; ++k) {
+    utime += 1000;
+    const state_t s = MakeState(utime, q);
+    lcm->publish(config.lcm.channels.state_estimate, &s);
+    force_command_t nominal{};
+    nominal.utime = nominal.sample_utime = utime;
+    nominal.seq = k;
+    ToArray(f_hold, nominal.force_n);
+    lcm->publish(config.lcm.channels.command_nominal, &nominal);
+    const std::size_t before = sink.received.size();
+    if (k == 0) {
+      lcm->handleTimeout(200);
+      continue;
+    }
+    ASSERT_TRUE(WaitFor(lcm.get(), sink, before + 1));
+    const force_command_t& safe = sink.received.back();
+    EXPECT_EQ(safe.sample_utime, utime);
+    EXPECT_EQ(safe.flags & force_command_t::FLAG_FALLBACK, 0);
+    EXPECT_NEAR((FromArray(safe.force_n) - f_hold).norm(), 0.0, 1e-9);
+  }
+
+  // Controller killed: states keep coming, nominal commands stop. Within
+  // stale_age_s of state time every state is answered by the fallback.
+  const int64_t last_nominal = utime;
+  const int64_t stale_us = static_cast<int64_t>(config.safety.stale_age_s * 1e6);
+  bool fallback_seen = false;
+  for (int k = 0; k < 100 && !fallback_seen; ++k) {
+    utime += 1000;
+    const state_t s = MakeState(utime, q);
+    const std::size_t before = sink.received.size();
+    lcm->publish(config.lcm.channels.state_estimate, &s);
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(100);
+    while (sink.received.size() == before && std::chrono::steady_clock::now() < deadline) {
+      lcm->handleTimeout(10);
+    }
+    if (sink.received.size() > before) {
+      const force_command_t& cmd = sink.received.back();
+      ASSERT_TRUE(cmd.flags & force_command_t::FLAG_FALLBACK) << "non-fallback without nominal";
+      EXPECT_TRUE(cmd.flags & force_command_t::FLAG_STALE_INPUT);
+      EXPECT_EQ(cmd.sample_utime, utime);
+      EXPECT_TRUE(FromArray(cmd.force_n).allFinite());
+      fallback_seen = true;
+    }
+  }
+  ASSERT_TRUE(fallback_seen);
+  EXPECT_LE(utime - last_nominal, stale_us + 1000) << "fallback later than the configured age";
+}
+
+}  // namespace
+}  // namespace stewart
