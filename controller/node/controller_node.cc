@@ -4,6 +4,7 @@
 
 #include "stewart/node/eigen_msg.h"
 #include "stewart/node/lcm_handle.h"
+#include "stewart/node/node_loop.h"
 #include "stewart/node/stop_signal.h"
 
 namespace stewart {
@@ -91,24 +92,11 @@ int ControllerNode::Run() {
                controller_.following_scenario() ? " + " + ch.setpoint
                                                 : " (live setpoints on " + ch.setpoint + ")",
                config_.lcm.url);
-  health_.MaybePublish(lcm_.get(), true);
-  while (!StopRequested()) {
-    // A stop signal interrupts the wait (EINTR): that is a clean exit.
-    if (lcm_->handleTimeout(kPollMs) < 0 && !StopRequested()) {
-      spdlog::error("controller: LCM receive failed");
-      health_.SetState(health_t::STATE_FAULT);
-      health_.MaybePublish(lcm_.get(), true);
-      return 1;
-    }
-    health_.MaybePublish(lcm_.get());
-    if (exit_at_end_ && controller_.scenario_finished()) {
-      spdlog::info("controller: scenario '{}' finished", controller_.scenario()->name());
-      break;
-    }
-  }
-  health_.SetState(health_t::STATE_STOPPED);
-  health_.MaybePublish(lcm_.get(), true);
-  return 0;
+  return RunNodeLoop("controller", lcm_.get(), &health_, kPollMs, [this] {
+    if (!exit_at_end_ || !controller_.scenario_finished()) return false;
+    spdlog::info("controller: scenario '{}' finished", controller_.scenario()->name());
+    return true;
+  });
 }
 
 }  // namespace stewart

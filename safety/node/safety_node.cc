@@ -1,9 +1,7 @@
 #include "safety_node.h"
 
-#include <spdlog/spdlog.h>
-
 #include "stewart/node/eigen_msg.h"
-#include "stewart/node/stop_signal.h"
+#include "stewart/node/node_loop.h"
 #include "stewart/safety/diagnostics_lcm.h"
 
 namespace stewart {
@@ -25,6 +23,7 @@ SafetyNode::SafetyNode(const StackConfig& config, lcm::LCM* lcm,
   lcm_->subscribe(config.lcm.channels.command_nominal, &SafetyNode::OnNominal, this)
       ->setQueueCapacity(kQueueCapacity);
   health_.SetCounter("fallback_commands", 0);
+  health_.SetState(health_t::STATE_OK);
 }
 
 const state_t* SafetyNode::FindState(int64_t sample_utime) const {
@@ -120,21 +119,6 @@ void SafetyNode::Publish(const state_t& state, int64_t sample_utime, const Vecto
   (void)state;
 }
 
-int SafetyNode::Run() {
-  health_.SetState(health_t::STATE_OK);
-  health_.MaybePublish(lcm_, true);
-  while (!StopRequested()) {
-    if (lcm_->handleTimeout(50) < 0 && !StopRequested()) {
-      spdlog::error("safety: LCM receive failed");
-      health_.SetState(health_t::STATE_FAULT);
-      health_.MaybePublish(lcm_, true);
-      return 1;
-    }
-    health_.MaybePublish(lcm_);
-  }
-  health_.SetState(health_t::STATE_STOPPED);
-  health_.MaybePublish(lcm_, true);
-  return 0;
-}
+int SafetyNode::Run() { return RunNodeLoop("safety", lcm_, &health_, 50); }
 
 }  // namespace stewart

@@ -1,0 +1,17 @@
+#pragma once
+#include <functional>
+#include <lcm/lcm-cpp.hpp>
+#include <string>
+
+#include "stewart/node/health_reporter.h"
+
+namespace stewart {
+
+/// The event loop of a message-driven node: handles LCM traffic and beats
+/// the heartbeat until a stop signal or until `done()` returns true. A
+/// receive error reports FAULT and returns 1; a clean stop reports STOPPED and
+/// returns 0. A stop signal interrupting the wait (EINTR) is a clean stop.
+int RunNodeLoop(const std::string& name, lcm::LCM* lcm, HealthReporter* health, int poll_ms,
+                const std::function<bool()>& done = {});
+
+}  // namespace stewart

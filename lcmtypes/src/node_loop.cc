@@ -1,0 +1,27 @@
+#include "stewart/node/node_loop.h"
+
+#include <spdlog/spdlog.h>
+
+#include "stewart/node/stop_signal.h"
+
+namespace stewart {
+
+int RunNodeLoop(const std::string& name, lcm::LCM* lcm, HealthReporter* health, int poll_ms,
+                const std::function<bool()>& done) {
+  health->MaybePublish(lcm, true);
+  while (!StopRequested()) {
+    if (lcm->handleTimeout(poll_ms) < 0 && !StopRequested()) {
+      spdlog::error("{}: LCM receive failed", name);
+      health->SetState(health_t::STATE_FAULT);
+      health->MaybePublish(lcm, true);
+      return 1;
+    }
+    health->MaybePublish(lcm);
+    if (done && done()) break;
+  }
+  health->SetState(health_t::STATE_STOPPED);
+  health->MaybePublish(lcm, true);
+  return 0;
+}
+
+}  // namespace stewart
