@@ -4,9 +4,31 @@ namespace stewart {
 
 EstimatorConfig ParseEstimatorConfig(const ConfigNode& estimator) {
   EstimatorConfig e;
+  e.process_model =
+      estimator.Choice("process_model", {"dynamics", "constant_velocity"}) == "dynamics"
+          ? EstimatorProcessModel::kDynamics
+          : EstimatorProcessModel::kConstantVelocity;
   e.process_accel_std_mps2 = estimator.PositiveDouble("process_accel_std_mps2");
   e.process_angaccel_std_radps2 = estimator.PositiveDouble("process_angaccel_std_radps2");
+  e.dynamics_accel_std_mps2 = estimator.PositiveDouble("dynamics_accel_std_mps2");
+  e.dynamics_angaccel_std_radps2 = estimator.PositiveDouble("dynamics_angaccel_std_radps2");
+  e.gyro_bias_walk_radps_per_sqrt_s =
+      estimator.NonNegativeDouble("gyro_bias_walk_radps_per_sqrt_s");
+  e.initial_velocity_std_mps = estimator.PositiveDouble("initial_velocity_std_mps");
+  e.initial_angular_rate_std_radps = estimator.PositiveDouble("initial_angular_rate_std_radps");
+  e.initial_gyro_bias_std_radps = estimator.PositiveDouble("initial_gyro_bias_std_radps");
+  e.leg_noise_inflation = estimator.PositiveDouble("leg_noise_inflation");
+  e.use_accelerometer = estimator.Bool("use_accelerometer");
   e.gating_chi2 = estimator.PositiveDouble("gating_chi2");
+  e.divergence_rejections = estimator.Int("divergence_rejections");
+  if (e.divergence_rejections < 1) estimator.Fail("divergence_rejections", "must be >= 1");
+  e.max_dt_s = estimator.PositiveDouble("max_dt_s");
+  e.command_timeout_s = estimator.PositiveDouble("command_timeout_s");
+  e.settle_samples = estimator.Int("settle_samples");
+  if (e.settle_samples < 0) estimator.Fail("settle_samples", "must not be negative");
+  e.max_gyro_radps = estimator.PositiveDouble("max_gyro_radps");
+  e.max_accel_mps2 = estimator.PositiveDouble("max_accel_mps2");
+  e.leg_range_margin_m = estimator.NonNegativeDouble("leg_range_margin_m");
   e.perfect_state = estimator.Bool("perfect_state");
   return e;
 }

@@ -162,6 +162,7 @@ void ExerciseLink(Stack* stack, bool expect_lost) {
   // +0.5 N on every leg for 0.1 s (~3 m/s^2 up), then commands stop: the
   // bridge goes stale after command_timeout_s and the locked legs hold.
   stack->Run(0.1, true, 0.5);
+  const std::size_t health_at_stop = stack->health.size();
   stack->Run(0.8, false);
   const std::size_t end = stack->sensors.size();
   ASSERT_GT(end, held + 150);
@@ -172,8 +173,17 @@ void ExerciseLink(Stack* stack, bool expect_lost) {
   ExpectSaneSamples(*stack, held);
   ASSERT_FALSE(stack->health.empty());
   const health_t& h = stack->health.back();
-  EXPECT_EQ(static_cast<int>(h.state), static_cast<int>(health_t::STATE_DEGRADED));
-  EXPECT_NE(h.last_error.find("stale"), std::string::npos) << h.last_error;
+  // The bridge must have reported the stale command (DEGRADED, zero drive).
+  // A heartbeat in between may report a momentary link drop instead when a
+  // loaded machine starves the emulator for > link_timeout_s, so the report
+  // is looked for among the heartbeats after the commands stopped.
+  bool stale_reported = false;
+  for (std::size_t k = health_at_stop; k < stack->health.size(); ++k) {
+    const health_t& hh = stack->health[k];
+    stale_reported = stale_reported || (hh.state == health_t::STATE_DEGRADED &&
+                                        hh.last_error.find("stale") != std::string::npos);
+  }
+  EXPECT_TRUE(stale_reported) << "last: state " << int{h.state} << ", " << h.last_error;
   EXPECT_EQ(Counter(h, "zero_drive"), 1);
   EXPECT_GT(Counter(h, "zero_drive_frames"), 50);
   EXPECT_GT(Counter(h, "commands_accepted"), 100);

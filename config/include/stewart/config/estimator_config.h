@@ -3,12 +3,42 @@
 
 namespace stewart {
 
-/// `estimator`: EKF tuning.
+/// Process model of the EKF (docs/estimator.md explains the choice).
+enum class EstimatorProcessModel {
+  kDynamics,          ///< qdd = M^-1 (H F - C qd - G), F = applied safe command
+  kConstantVelocity,  ///< qdd = 0 with white acceleration noise
+};
+
+/// `estimator`: EKF tuning. Sensor noise itself comes from `sensors`.
 struct EstimatorConfig {
-  double process_accel_std_mps2 = 0.5;
-  double process_angaccel_std_radps2 = 2.0;
-  double gating_chi2 = 30.0;
-  bool perfect_state = false;  ///< pass ground truth through; testing only
+  EstimatorProcessModel process_model = EstimatorProcessModel::kConstantVelocity;
+  /// Constant-velocity model (and the dynamics model without a fresh command):
+  /// std of the acceleration, white over one sample (m/s^2, rad/s^2).
+  double process_accel_std_mps2 = 0.2;
+  double process_angaccel_std_radps2 = 0.5;
+  /// Dynamics model: std of the model error as an acceleration.
+  double dynamics_accel_std_mps2 = 0.001;
+  double dynamics_angaccel_std_radps2 = 0.01;
+  /// Random walk of the gyro bias (rad/s per sqrt(s)).
+  double gyro_bias_walk_radps_per_sqrt_s = 1.0e-5;
+  double initial_velocity_std_mps = 0.05;
+  double initial_angular_rate_std_radps = 0.2;
+  double initial_gyro_bias_std_radps = 0.01;
+  /// Multiplies the leg-length variance (noise + ADC quantisation); > 1
+  /// absorbs the time correlation of the quantisation error.
+  double leg_noise_inflation = 1.6;
+  bool use_accelerometer = true;
+  double gating_chi2 = 30.0;  ///< innovation gate, per sensor group and update
+  /// Consecutive rejected leg updates after which the filter is diverged and
+  /// re-initialised from forward kinematics.
+  int divergence_rejections = 50;
+  double max_dt_s = 0.05;            ///< larger sample gaps re-initialise
+  double command_timeout_s = 0.05;   ///< older commands are not used
+  int settle_samples = 200;          ///< STATUS_INITIALIZING after (re)init
+  double max_gyro_radps = 35.0;      ///< larger readings are rejected
+  double max_accel_mps2 = 160.0;     ///< larger readings are rejected
+  double leg_range_margin_m = 0.01;  ///< accepted beyond the stroke ends
+  bool perfect_state = false;        ///< pass ground truth through; testing only
 };
 
 EstimatorConfig ParseEstimatorConfig(const ConfigNode& estimator);

@@ -1,0 +1,81 @@
+#pragma once
+// Extended Kalman filter fusing the leg potentiometers and the IMU into the
+// platform state [q, qd] plus the gyro bias. docs/estimator.md describes the
+// model, the tuning and the measured accuracy. No LCM, no heap allocation
+// per update, and time only from the samples' utime.
+#include "stewart/config/estimator_config.h"
+#include "stewart/config/platform_config.h"
+#include "stewart/config/sensor_config.h"
+#include "stewart/estimator/ekf_types.h"
+#include "stewart/model/platform_params.h"
+
+namespace stewart {
+
+class Ekf {
+ public:
+  Ekf(const PlatformParams& params, const ActuatorConfig& actuators, const SensorConfig& sensors,
+      const EstimatorConfig& config, const Vector6d& home_pose);
+
+  /// The leg forces being applied (N) from command sample time `utime` (us):
+  /// the process model's input.
+  void SetForceCommand(int64_t utime, const Vector6d& force_n);
+
+  /// One predict + correct step per sensor sample. Before the first valid leg
+  /// reading it initialises from forward kinematics.
+  UpdateResult Update(const SensorSample& sample);
+
+  /// Starts from a given state with one-sigma uncertainty `std` (tests and
+  /// tools; the process initialises itself from the legs).
+  void Initialize(int64_t utime, const Vector6d& q, const Vector6d& qd, const EkfVector& std);
+  void Reset();
+
+  bool initialized() const { return initialized_; }
+  const EkfVector& x() const { return x_; }
+  const EkfMatrix& P() const { return P_; }
+  Estimate estimate() const;
+  /// Normalised innovation squared of the last leg update (chi-square, 6 dof).
+  double last_leg_nis() const { return last_leg_nis_; }
+  /// qdd used by the last prediction.
+  const Vector6d& predicted_qdd() const { return qdd_; }
+
+ private:
+  bool InitializeFromLegs(const SensorSample& sample, uint32_t* events);
+  void Predict(double dt_s, int64_t utime, uint32_t* events);
+  void CorrectLegs(const Vector6d& leg_length_m, uint32_t* events);
+  void CorrectGyro(const Vector3d& gyro_radps, uint32_t* events);
+  void CorrectAccel(const Vector3d& accel_mps2, uint32_t* events);
+  void CorrectOrientation(const Vector3d& rpy_rad, uint32_t* events);
+  /// Kalman correction with innovation `y`; false (and no change) when the
+  /// innovation fails the gate.
+  template <int M>
+  bool Correct(const Eigen::Matrix<double, M, 1>& y,
+               const Eigen::Matrix<double, M, kEkfStateSize>& H,
+               const Eigen::Matrix<double, M, M>& R, double* nis);
+  bool LegsUsable(const SensorSample& sample, uint32_t* events) const;
+
+  PlatformParams params_;
+  ActuatorConfig actuators_;
+  EstimatorConfig config_;
+  Vector6d home_pose_;
+  Vector3d imu_offset_m_;
+  double leg_variance_m2_;
+  double gyro_variance_;
+  double accel_variance_;
+  double orientation_variance_;
+
+  bool initialized_ = false;
+  int64_t last_utime_ = 0;
+  EkfVector x_ = EkfVector::Zero();
+  EkfMatrix P_ = EkfMatrix::Identity();
+  Vector6d qdd_ = Vector6d::Zero();
+  bool qdd_from_dynamics_ = false;
+  bool has_command_ = false;
+  int64_t command_utime_ = 0;
+  Vector6d command_n_ = Vector6d::Zero();
+  int consecutive_leg_rejections_ = 0;
+  int samples_since_init_ = 0;
+  bool diverged_ = false;
+  double last_leg_nis_ = 0.0;
+};
+
+}  // namespace stewart

@@ -1,0 +1,75 @@
+#pragma once
+// Fixed-size types of the estimator: the EKF state layout, one sensor sample,
+// the estimate, and the events an update can report.
+#include <cstdint>
+
+#include "stewart/model/types.h"
+
+namespace stewart {
+
+/// EKF state x = [q (6), qd (6), b_g (3)]: pose (m, rad; Z-Y-X Euler), its
+/// time derivative (m/s, rad/s Euler rates), gyro bias (rad/s, {P} axes).
+constexpr int kEkfStateSize = 15;
+constexpr int kEkfQ = 0;
+constexpr int kEkfQd = 6;
+constexpr int kEkfGyroBias = 12;
+using EkfVector = Eigen::Matrix<double, kEkfStateSize, 1>;
+using EkfMatrix = Eigen::Matrix<double, kEkfStateSize, kEkfStateSize>;
+
+/// One sensor sample, as the library sees it (no LCM types here).
+struct SensorSample {
+  int64_t utime = 0;  ///< sample time (us): the only clock of the filter
+  Vector6d leg_length_m = Vector6d::Zero();
+  Vector3d gyro_radps = Vector3d::Zero();  ///< {P} axes
+  Vector3d accel_mps2 = Vector3d::Zero();  ///< specific force, {P} axes
+  Vector3d orientation_rpy_rad = Vector3d::Zero();
+  bool legs_valid = true;  ///< false when the device flags a leg fault
+  bool imu_valid = true;   ///< false when the device flags an IMU fault
+  bool has_orientation = false;
+};
+
+/// The filter's output for one sample.
+struct Estimate {
+  int64_t utime = 0;  ///< = utime of the sensor sample
+  Vector6d q = Vector6d::Zero();
+  Vector6d qd = Vector6d::Zero();
+  Vector6d q_std = Vector6d::Zero();
+  Vector6d qd_std = Vector6d::Zero();
+  Vector3d gyro_bias_radps = Vector3d::Zero();
+  bool initializing = false;  ///< within settle_samples of a (re)initialisation
+  bool diverged = false;      ///< a divergence was detected and the filter restarted
+};
+
+/// Events of one update, as a bit set. Rejections are bad or inconsistent
+/// inputs that were not used; the others are informational.
+enum EkfEvent : uint32_t {
+  kEventInitialized = 1u << 0,    ///< (re)initialised from forward kinematics
+  kEventReinitTimeGap = 1u << 1,  ///< dt > max_dt_s: restarted
+  kEventDiverged = 1u << 2,       ///< divergence detected: restarted
+  kEventNoCommand = 1u << 3,      ///< dynamics model had no fresh command
+  kRejectTime = 1u << 4,          ///< dt <= 0: the whole sample is ignored
+  kRejectLegsNonFinite = 1u << 5,
+  kRejectLegsRange = 1u << 6,
+  kRejectGyroInvalid = 1u << 7,  ///< non-finite or out of range
+  kRejectAccelInvalid = 1u << 8,
+  kRejectOrientationInvalid = 1u << 9,
+  kGateLegs = 1u << 10,  ///< innovation outside the chi-square gate
+  kGateGyro = 1u << 11,
+  kGateAccel = 1u << 12,
+  kGateOrientation = 1u << 13,
+  kRejectInitFailed = 1u << 14,  ///< forward kinematics did not converge
+  kEventLast = kRejectInitFailed,
+};
+
+/// Short snake_case name of one event bit (health counter names).
+const char* EkfEventName(EkfEvent event);
+/// True for the bits that are rejected inputs.
+bool IsRejection(EkfEvent event);
+
+struct UpdateResult {
+  uint32_t events = 0;
+  bool has_estimate = false;  ///< false: nothing to publish for this sample
+  bool Has(EkfEvent e) const { return (events & e) != 0; }
+};
+
+}  // namespace stewart

@@ -1,0 +1,33 @@
+#pragma once
+// Measurement models h(x) of the EKF and their Jacobians dh/dx, for the state
+// layout of ekf_types.h. Each equation is the model's (kinematics.h, imu.h);
+// only the Jacobian bookkeeping lives here.
+#include "stewart/estimator/ekf_types.h"
+#include "stewart/model/platform_params.h"
+
+namespace stewart {
+
+template <int M>
+using MeasurementJacobian = Eigen::Matrix<double, M, kEkfStateSize>;
+
+/// ADC step of the leg potentiometers (m): codes 0 .. 2^bits - 1 over the
+/// stroke; 0 when bits == 0 (no quantisation).
+double LegAdcStep(double stroke_m, int adc_bits);
+
+/// Leg lengths L(q) by inverse kinematics (paper eq. 1); dL/dq = J_l, so no
+/// forward-kinematics solve is needed in the update.
+void PredictLegLengths(const PlatformParams& params, const EkfVector& x, Vector6d* leg_length_m,
+                       MeasurementJacobian<6>* jacobian);
+
+/// Gyro: omega_P = R^T E(r) rd + b_g (rad/s, {P}).
+void PredictGyro(const EkfVector& x, Vector3d* gyro_radps, MeasurementJacobian<3>* jacobian);
+
+/// Accelerometer: specific force at the IMU, {P} (m/s^2), given the
+/// predicted qdd. The Jacobian holds qdd fixed (docs/estimator.md).
+void PredictAccel(const EkfVector& x, const Vector6d& qdd, const Vector3d& imu_offset_m,
+                  double gravity_mps2, Vector3d* accel_mps2, MeasurementJacobian<3>* jacobian);
+
+/// Wraps an angle difference to (-pi, pi].
+double WrapAngle(double angle_rad);
+
+}  // namespace stewart

@@ -1,0 +1,26 @@
+#pragma once
+// Process model of the EKF: the platform's forward dynamics driven by the
+// applied leg forces (paper eq. 2), with the lead-screw friction the
+// actuators lose:
+//
+//   qdd = M(q)^-1 (H(q) (F - c_v ld) - C(q,qd) qd - G(q)),  ld = J_l qd = H^T qd,
+//
+// F in N (leg forces, clipped to the actuator limit by the caller), c_v in
+// N/(m/s), qdd in m/s^2 and rad/s^2 (Euler accelerations).
+#include "stewart/model/platform_params.h"
+#include "stewart/model/types.h"
+
+namespace stewart {
+
+Vector6d DynamicsAcceleration(const PlatformParams& params, double friction_nspm, const Vector6d& q,
+                              const Vector6d& qd, const Vector6d& force_n);
+
+/// qdd and its Jacobians: dqdd/dq by forward differences, dqdd/dqd from the
+/// friction term only (the Coriolis part is O(|qd|), see the source). Under
+/// force control the platform is a neutrally or un-stably balanced body, so
+/// dqdd/dq must be in the covariance propagation (docs/estimator.md).
+void DynamicsAccelerationJacobians(const PlatformParams& params, double friction_nspm,
+                                   const Vector6d& q, const Vector6d& qd, const Vector6d& force_n,
+                                   Vector6d* qdd, Matrix6d* dqdd_dq, Matrix6d* dqdd_dqd);
+
+}  // namespace stewart

@@ -1,0 +1,111 @@
+// Accuracy of the EKF on simulated noisy sensors (10-bit ADC legs, gyro with
+// bias, accelerometer) along the paper's scenario. The bounds are those
+// stated in docs/estimator.md; measured values are printed for the docs.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+
+#include "ekf_harness.h"
+
+namespace stewart::test {
+namespace {
+
+struct Bounds {
+  double position_m, angle_rad, velocity_mps, rate_radps;
+};
+
+// docs/estimator.md, "Measured accuracy".
+constexpr Bounds kConstantVelocityBounds{1e-4, 1e-4, 1e-3, 1e-3};
+constexpr Bounds kDynamicsBounds{5e-5, 5e-5, 3e-4, 3e-4};
+
+Ekf MakeEkf(const StackConfig& c) {
+  return Ekf(c.platform, c.actuators, c.sensors, c.estimator, c.home_pose);
+}
+
+void Print(const char* name, const RunStats& s) {
+  const Vector6d q = s.q_err.Rms(), qd = s.qd_err.Rms();
+  std::printf("%-26s q [mm, mrad]     %6.3f %6.3f %6.3f | %6.3f %6.3f %6.3f\n", name, 1e3 * q(0),
+              1e3 * q(1), 1e3 * q(2), 1e3 * q(3), 1e3 * q(4), 1e3 * q(5));
+  std::printf("%-26s qd [mm/s, mrad/s] %6.3f %6.3f %6.3f | %6.3f %6.3f %6.3f  |b_g err| %.1e\n", "",
+              1e3 * qd(0), 1e3 * qd(1), 1e3 * qd(2), 1e3 * qd(3), 1e3 * qd(4), 1e3 * qd(5),
+              s.final_bias_error.norm());
+}
+
+void ExpectWithin(const RunStats& s, const Bounds& b) {
+  const Vector6d q = s.q_err.Rms(), qd = s.qd_err.Rms();
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_LT(q(i), b.position_m) << "axis " << i;
+    EXPECT_LT(q(3 + i), b.angle_rad) << "axis " << 3 + i;
+    EXPECT_LT(qd(i), b.velocity_mps) << "axis " << i;
+    EXPECT_LT(qd(3 + i), b.rate_radps) << "axis " << 3 + i;
+  }
+  // The gyro bias (2e-3 rad/s in the config) is learned to a few percent.
+  EXPECT_LT(s.final_bias_error.norm(), 1e-4);
+  EXPECT_EQ(s.Count(kGateLegs), 0);
+  EXPECT_EQ(s.with_estimate + 1000, s.samples);  // every sample after the settle second
+}
+
+StackConfig WithModel(EstimatorProcessModel model, bool accel = true) {
+  StackConfig c = EstimatorTestConfig();
+  c.estimator.process_model = model;
+  c.estimator.use_accelerometer = accel;
+  return c;
+}
+
+TEST(EkfAccuracy, DefaultConfigIsConstantVelocityAndNotPerfectState) {
+  EXPECT_EQ(EstimatorTestConfig().estimator.process_model,
+            EstimatorProcessModel::kConstantVelocity);
+  EXPECT_FALSE(EstimatorTestConfig().estimator.perfect_state);
+}
+
+TEST(EkfAccuracy, ConstantVelocityModelOnPaperScenario) {
+  const StackConfig c = WithModel(EstimatorProcessModel::kConstantVelocity);
+  Ekf ekf = MakeEkf(c);
+  const RunStats s = RunScenario(c, 1, ScenarioTruth::kDurationS, 1.0, &ekf);
+  Print("constant velocity", s);
+  ExpectWithin(s, kConstantVelocityBounds);
+}
+
+TEST(EkfAccuracy, DynamicsModelOnPaperScenario) {
+  const StackConfig c = WithModel(EstimatorProcessModel::kDynamics);
+  Ekf ekf = MakeEkf(c);
+  const RunStats s = RunScenario(c, 1, ScenarioTruth::kDurationS, 1.0, &ekf);
+  Print("dynamics (exact model)", s);
+  ExpectWithin(s, kDynamicsBounds);
+  EXPECT_EQ(s.Count(kEventNoCommand), 0);
+}
+
+// Ablations for docs/estimator.md: what the accelerometer adds, and what a
+// wrong model (platform and rod 10% lighter, no friction) does to each model.
+TEST(EkfAccuracy, AblationsAndModelMismatch) {
+  for (auto model : {EstimatorProcessModel::kConstantVelocity, EstimatorProcessModel::kDynamics}) {
+    const StackConfig c = WithModel(model, false);
+    Ekf ekf = MakeEkf(c);
+    const RunStats s = RunScenario(c, 1, ScenarioTruth::kDurationS, 1.0, &ekf);
+    Print(model == EstimatorProcessModel::kDynamics ? "dynamics, no accel" : "const vel, no accel",
+          s);
+  }
+  RunStats mismatch[2];
+  int i = 0;
+  for (auto model : {EstimatorProcessModel::kConstantVelocity, EstimatorProcessModel::kDynamics}) {
+    const StackConfig c = WithModel(model);
+    StackConfig wrong = c;
+    wrong.platform.platform_mass_kg *= 0.9;
+    wrong.platform.leg.rod_mass_kg *= 0.9;
+    wrong.actuators.viscous_friction_nspm = 0.0;
+    Ekf ekf = MakeEkf(wrong);
+    mismatch[i] = RunScenario(c, 1, ScenarioTruth::kDurationS, 1.0, &ekf);
+    Print(i == 0 ? "const vel, mass -10%" : "dynamics, mass -10%", mismatch[i]);
+    std::printf("  gated leg updates %d, divergences %d\n", mismatch[i].Count(kGateLegs),
+                mismatch[i].Count(kEventDiverged));
+    ++i;
+  }
+  // The constant-velocity model does not use the mass: unaffected.
+  ExpectWithin(mismatch[0], kConstantVelocityBounds);
+  // The dynamics model tuned for an exact model is not robust to it: this is
+  // why it is not the default (docs/estimator.md).
+  EXPECT_GT(mismatch[1].qd_err.Rms().head<3>().maxCoeff(), kConstantVelocityBounds.velocity_mps);
+}
+
+}  // namespace
+}  // namespace stewart::test

@@ -1,0 +1,34 @@
+#pragma once
+// Runs the EKF over the scenario truth, one update per 1 kHz sample, the way
+// the process does (command of the previous sample, then the new sample).
+#include <functional>
+
+#include "scenario_truth.h"
+#include "stewart/estimator/ekf.h"
+
+namespace stewart::test {
+
+struct RunStats {
+  RmsAccumulator q_err;
+  RmsAccumulator qd_err;
+  Vector3d final_bias_error = Vector3d::Zero();
+  int samples = 0;
+  int with_estimate = 0;
+  int event_counts[32] = {};
+  int Count(EkfEvent e) const;
+};
+
+/// Hook per sample: may edit the sample before the update (outlier and NaN
+/// injection), sees the EKF after it. Errors are accumulated for t >= settle_s.
+struct RunHooks {
+  std::function<void(int k, SensorSample*)> before;
+  std::function<void(int k, const Ekf&, const TruthSample&, const UpdateResult&)> after;
+};
+
+RunStats RunScenario(const StackConfig& config, unsigned seed, double t_end_s, double settle_s,
+                     Ekf* ekf, const RunHooks& hooks = {},
+                     const TruthDisturbance& disturbance = {});
+
+const StackConfig& EstimatorTestConfig();
+
+}  // namespace stewart::test

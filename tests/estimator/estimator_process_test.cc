@@ -1,0 +1,207 @@
+// The real `estimator` process on a private LCM URL: sensor messages in,
+// state estimates out with the sensor sample's utime; bad samples are
+// counted in its health; the perfect-state pass-through only on request.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "scenario_truth.h"
+#include "stewart/force_command_t.hpp"
+#include "stewart/health_t.hpp"
+#include "stewart/node/lcm_handle.h"
+#include "stewart/sensor_t.hpp"
+#include "stewart/state_t.hpp"
+
+extern char** environ;
+
+namespace stewart::test {
+namespace {
+
+constexpr int kPortEstimate = 7720;  // this file's private LCM ports
+constexpr int kPortPerfect = 7721;
+
+// Starts the estimator binary; SIGTERM and reaps it on destruction.
+class Process {
+ public:
+  explicit Process(std::vector<std::string> args) {
+    args.insert(args.begin(), ESTIMATOR_BINARY);
+    std::vector<char*> argv;
+    for (auto& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    ok_ = posix_spawn(&pid_, ESTIMATOR_BINARY, nullptr, nullptr, argv.data(), environ) == 0;
+  }
+  ~Process() {
+    if (ok_ && !stopped_) Stop();
+  }
+  int Stop() {
+    stopped_ = true;
+    kill(pid_, SIGTERM);
+    int status = 0;
+    waitpid(pid_, &status, 0);
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  }
+  bool ok() const { return ok_; }
+
+ private:
+  pid_t pid_ = 0;
+  bool ok_ = false;
+  bool stopped_ = false;
+};
+
+class Sink {
+ public:
+  void OnState(const lcm::ReceiveBuffer*, const std::string&, const state_t* msg) {
+    states.push_back(*msg);
+  }
+  void OnHealth(const lcm::ReceiveBuffer*, const std::string&, const health_t* msg) {
+    if (msg->name == "estimator") health.push_back(*msg);
+  }
+  std::vector<state_t> states;
+  std::vector<health_t> health;
+};
+
+template <typename Pred>
+bool PumpUntil(lcm::LCM* lcm, Pred done, double timeout_s) {
+  const auto deadline = std::chrono::steady_clock::now() +
+                        std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                            std::chrono::duration<double>(timeout_s));
+  while (!done()) {
+    if (std::chrono::steady_clock::now() > deadline) return false;
+    lcm->handleTimeout(20);
+  }
+  return true;
+}
+
+sensor_t ToMessage(const SensorSample& s, int64_t seq) {
+  sensor_t m{};
+  m.utime = s.utime;
+  m.seq = seq;
+  m.sample_utime = s.utime;
+  for (int i = 0; i < 6; ++i) m.leg_length_m[i] = s.leg_length_m(i);
+  for (int i = 0; i < 3; ++i) {
+    m.gyro_radps[i] = s.gyro_radps(i);
+    m.accel_mps2[i] = s.accel_mps2(i);
+  }
+  return m;
+}
+
+int64_t Counter(const health_t& h, const std::string& name) {
+  for (int i = 0; i < h.num_counters; ++i) {
+    if (h.counter_names[static_cast<size_t>(i)] == name)
+      return h.counter_values[static_cast<size_t>(i)];
+  }
+  return 0;
+}
+
+TEST(EstimatorProcess, EstimatesCarryTheSensorSampleUtime) {
+  const StackConfig config = LoadStackConfig(DefaultConfigPath());
+  const ChannelNames& ch = config.lcm.channels;
+  const std::string url = PrivateLcmUrl(kPortEstimate);
+  auto lcm = MakeLcm(url);
+  Sink sink;
+  lcm->subscribe(ch.state_estimate, &Sink::OnState, &sink)->setQueueCapacity(2000);
+  lcm->subscribe(ch.health, &Sink::OnHealth, &sink)->setQueueCapacity(100);
+  Process proc({"--config", DefaultConfigPath(), "--lcm-url", url, "--log-level", "error"});
+  ASSERT_TRUE(proc.ok());
+  // Its first heartbeat: the process is up and subscribed.
+  ASSERT_TRUE(PumpUntil(
+      lcm.get(), [&] { return !sink.health.empty(); }, 10.0));
+
+  ScenarioTruth truth(config, 11);
+  constexpr int kSamples = 600;
+  constexpr int kNanSample = 300;
+  std::map<int64_t, TruthState> published;
+  TruthSample previous;
+  int64_t seq = 0;
+  for (int k = 0; k < kSamples; ++k) {
+    const TruthSample t = truth.Next();
+    if (k > 0) {
+      force_command_t cmd{};
+      cmd.utime = previous.utime;
+      cmd.seq = k - 1;
+      cmd.sample_utime = previous.utime;
+      for (int i = 0; i < 6; ++i) cmd.force_n[i] = previous.force_n(i);
+      lcm->publish(ch.command_safe, &cmd);
+    }
+    sensor_t msg = ToMessage(t.sensors, seq++);
+    if (k == kNanSample) msg.leg_length_m[1] = NAN;
+    lcm->publish(ch.sensors, &msg);
+    published[t.utime] = t.state;
+    if (k == kNanSample) {
+      lcm->publish(ch.sensors, &msg);  // a duplicate: rejected, no estimate
+    }
+    previous = t;
+    lcm->handleTimeout(0);
+    std::this_thread::sleep_for(std::chrono::microseconds(300));
+  }
+  ASSERT_TRUE(PumpUntil(
+      lcm.get(), [&] { return sink.states.size() >= kSamples; }, 10.0))
+      << "received " << sink.states.size();
+  ASSERT_EQ(sink.states.size(), static_cast<size_t>(kSamples));
+  for (size_t i = 0; i < sink.states.size(); ++i) {
+    const state_t& s = sink.states[i];
+    ASSERT_EQ(s.utime, s.sample_utime);
+    ASSERT_EQ(s.seq, static_cast<int64_t>(i));
+    ASSERT_EQ(published.count(s.sample_utime), 1u) << "unknown sample utime " << s.sample_utime;
+    for (int j = 0; j < 6; ++j) ASSERT_TRUE(std::isfinite(s.q[j]) && std::isfinite(s.qd[j]));
+    if (i > 0) {
+      ASSERT_GT(s.sample_utime, sink.states[i - 1].sample_utime);
+    }
+  }
+  const state_t& last = sink.states.back();
+  EXPECT_EQ(last.status, +state_t::STATUS_VALID);
+  const TruthState& truth_last = published[last.sample_utime];
+  for (int j = 0; j < 3; ++j) {
+    EXPECT_NEAR(last.q[j], truth_last.q(j), 2e-4);
+    EXPECT_GT(last.q_std[j], 0.0);
+    EXPECT_LT(last.q_std[j], 2e-4);
+  }
+  // Health: the NaN legs and the duplicate are counted rejections.
+  ASSERT_TRUE(PumpUntil(
+      lcm.get(), [&] { return sink.health.back().messages_in >= 2 * kSamples; }, 5.0));
+  const health_t& h = sink.health.back();
+  EXPECT_EQ(h.rejected_inputs, 2);
+  EXPECT_EQ(Counter(h, "rejected_legs_non_finite"), 1);
+  EXPECT_EQ(Counter(h, "rejected_non_increasing_time"), 1);
+  EXPECT_EQ(h.messages_out, kSamples);
+  EXPECT_EQ(proc.Stop(), 0);
+}
+
+TEST(EstimatorProcess, PerfectStateOnlyOnRequest) {
+  const StackConfig config = LoadStackConfig(DefaultConfigPath());
+  const ChannelNames& ch = config.lcm.channels;
+  const std::string url = PrivateLcmUrl(kPortPerfect);
+  auto lcm = MakeLcm(url);
+  Sink sink;
+  lcm->subscribe(ch.state_estimate, &Sink::OnState, &sink);
+  lcm->subscribe(ch.health, &Sink::OnHealth, &sink);
+  Process proc({"--config", DefaultConfigPath(), "--lcm-url", url, "--log-level", "error",
+                "--perfect-state"});
+  ASSERT_TRUE(proc.ok());
+  ASSERT_TRUE(PumpUntil(
+      lcm.get(), [&] { return !sink.health.empty(); }, 10.0));
+  state_t truth{};
+  truth.utime = 5000;
+  truth.seq = 9;
+  truth.sample_utime = 5000;
+  truth.q[2] = 0.4;
+  truth.status = state_t::STATUS_GROUND_TRUTH;
+  lcm->publish(ch.state_truth, &truth);
+  ASSERT_TRUE(PumpUntil(
+      lcm.get(), [&] { return !sink.states.empty(); }, 5.0));
+  EXPECT_EQ(sink.states[0].sample_utime, 5000);
+  EXPECT_DOUBLE_EQ(sink.states[0].q[2], 0.4);
+  EXPECT_EQ(sink.states[0].status, state_t::STATUS_VALID | state_t::STATUS_PERFECT_STATE);
+  EXPECT_EQ(proc.Stop(), 0);
+}
+
+}  // namespace
+}  // namespace stewart::test
