@@ -34,7 +34,7 @@ Ekf::Ekf(const PlatformParams& params, const ActuatorConfig& actuators, const Se
       config_(config),
       home_pose_(home_pose),
       imu_offset_m_(sensors.imu_offset_m) {
-  const double step = LegAdcStep(actuators.stroke_m, sensors.leg_adc_bits);
+  const double step = LegAdcStepM(sensors, actuators.stroke_m);
   // The quantisation error is uniform over one ADC step: variance step^2/12.
   leg_variance_m2_ =
       config.leg_noise_inflation *

@@ -31,12 +31,6 @@ void CentralDifference(const EkfVector& x, int first, int count, Fn h,
 
 }  // namespace
 
-double LegAdcStep(double stroke_m, int adc_bits) {
-  if (adc_bits <= 0) return 0.0;
-  // Codes 0 .. 2^bits - 1 span the stroke, as plant_sim's LegAdcResolution.
-  return stroke_m / (std::ldexp(1.0, adc_bits) - 1.0);
-}
-
 void PredictLegLengths(const PlatformParams& params, const EkfVector& x, Vector6d* leg_length_m,
                        MeasurementJacobian<6>* jacobian) {
   const Vector6d q = x.segment<6>(kEkfQ);

@@ -7,9 +7,7 @@
 namespace stewart {
 
 double LegAdcResolution(const SensorConfig& sensors, const ActuatorConfig& actuators) {
-  if (sensors.leg_adc_bits <= 0) return 0.0;
-  const double max_code = std::ldexp(1.0, sensors.leg_adc_bits) - 1.0;
-  return actuators.stroke_m / max_code;
+  return LegAdcStepM(sensors, actuators.stroke_m);
 }
 
 Vector6d QuantiseLegLength(const SensorConfig& sensors, const ActuatorConfig& actuators,

@@ -122,7 +122,7 @@ SensorSample ScenarioTruth::Sense(int64_t utime, const TruthState& s) {
   const SensorConfig& sc = config_.sensors;
   SensorSample out;
   out.utime = utime;
-  const double step = LegAdcStep(config_.actuators.stroke_m, sc.leg_adc_bits);
+  const double step = LegAdcStepM(sc, config_.actuators.stroke_m);
   const double l_min = config_.platform.leg_min_length_m;
   const Vector6d legs = InverseKinematics(config_.platform, s.q);
   for (int i = 0; i < 6; ++i) {

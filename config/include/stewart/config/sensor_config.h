@@ -20,4 +20,9 @@ struct SensorConfig {
 
 SensorConfig ParseSensorConfig(const ConfigNode& sensors);
 
+/// Leg-length step of the potentiometer ADC (m): codes 0 .. 2^bits - 1 span
+/// the stroke, so stroke / (2^bits - 1); 0 when leg_adc_bits = 0 (no
+/// quantisation). The simulator quantises with it, the estimator models it.
+double LegAdcStepM(const SensorConfig& sensors, double stroke_m);
+
 }  // namespace stewart

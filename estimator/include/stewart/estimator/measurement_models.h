@@ -10,10 +10,6 @@ namespace stewart {
 template <int M>
 using MeasurementJacobian = Eigen::Matrix<double, M, kEkfStateSize>;
 
-/// ADC step of the leg potentiometers (m): codes 0 .. 2^bits - 1 over the
-/// stroke; 0 when bits == 0 (no quantisation).
-double LegAdcStep(double stroke_m, int adc_bits);
-
 /// Leg lengths L(q) by inverse kinematics (paper eq. 1); dL/dq = J_l, so no
 /// forward-kinematics solve is needed in the update.
 void PredictLegLengths(const PlatformParams& params, const EkfVector& x, Vector6d* leg_length_m,
