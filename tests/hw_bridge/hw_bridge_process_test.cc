@@ -161,7 +161,15 @@ void ExerciseLink(Stack* stack, bool expect_lost) {
   const double before = MeanLegLength(stack->sensors, held - 50, held);
   // +0.5 N on every leg for 0.1 s (~3 m/s^2 up), then commands stop: the
   // bridge goes stale after command_timeout_s and the locked legs hold.
-  stack->Run(0.1, true, 0.5);
+  // The push lasts 100 device samples (each answered by a command), not
+  // 0.1 s of wall time: a loaded machine may stall the link for a while, and
+  // the test is about the effect of the commands, not the link's speed.
+  const std::size_t push_start = stack->sensors.size();
+  const auto push_deadline = std::chrono::steady_clock::now() + std::chrono::seconds(2);
+  while (stack->sensors.size() < push_start + 100 &&
+         std::chrono::steady_clock::now() < push_deadline) {
+    stack->Run(0.005, true, 0.5);
+  }
   const std::size_t health_at_stop = stack->health.size();
   stack->Run(0.8, false);
   const std::size_t end = stack->sensors.size();
