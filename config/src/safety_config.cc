@@ -44,6 +44,16 @@ SafetyVariant ParseSafetyVariant(const std::string& name) {
   throw std::invalid_argument("unknown safety variant '" + name + "' (closed_form | paper | qp)");
 }
 
+std::string ToString(CorrectionMetric metric) {
+  return metric == CorrectionMetric::kAcceleration ? "acceleration" : "force";
+}
+
+CorrectionMetric ParseCorrectionMetric(const std::string& name) {
+  if (name == "force") return CorrectionMetric::kForce;
+  if (name == "acceleration") return CorrectionMetric::kAcceleration;
+  throw std::invalid_argument("unknown correction metric '" + name + "' (force | acceleration)");
+}
+
 SafetyConfig ParseSafetyConfig(const ConfigNode& safety) {
   SafetyConfig s;
   s.variant = ParseSafetyVariant(safety.Choice("variant", {"closed_form", "paper", "qp"}));
@@ -83,6 +93,11 @@ SafetyConfig ParseSafetyConfig(const ConfigNode& safety) {
     if (!(*stop > 0.0)) safety.Fail("stop_time_s", "must be positive");
     s.stop_time_s = *stop;
   }
+  if (safety.Has("correction_metric")) {
+    s.correction_metric =
+        ParseCorrectionMetric(safety.Choice("correction_metric", {"force", "acceleration"}));
+  }
+  if (safety.Has("model_leg_friction")) s.model_leg_friction = safety.Bool("model_leg_friction");
   return s;
 }
 

@@ -43,6 +43,12 @@ StackConfig ParseRoot(const YAML::Node& yaml, const std::string& source) {
   c.plant_sim = ParsePlantSimConfig(root.Child("plant_sim"));
   c.hw_bridge = ParseHwBridgeConfig(root.Child("hw_bridge"));
   c.lcm = ParseLcmConfig(root.Child("lcm"), root.Child("rates"));
+  // One friction coefficient, the actuators': the controller and the filter
+  // model what the plant has (or nothing, when told not to).
+  c.controller.leg_friction_nspm =
+      c.controller.compensate_friction ? c.actuators.viscous_friction_nspm : 0.0;
+  c.safety.leg_friction_nspm =
+      c.safety.model_leg_friction ? c.actuators.viscous_friction_nspm : 0.0;
   ValidateStackConfig(c);
   return c;
 }

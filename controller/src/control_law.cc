@@ -12,7 +12,9 @@ Vector6d NominalForce(const PlatformParams& platform, const ControllerConfig& ga
                       const Vector6d& q, const Vector6d& qd, const Setpoint& setpoint,
                       DynamicsTerms* terms) {
   EvaluateDynamics(platform, q, qd, terms);
-  return InverseDynamics(*terms, PdAcceleration(gains, q, qd, setpoint));
+  // The legs lose LegViscousFriction on the way: command it on top.
+  return InverseDynamics(*terms, PdAcceleration(gains, q, qd, setpoint)) -
+         LegViscousFriction(gains.leg_friction_nspm, terms->H.transpose() * qd);
 }
 
 }  // namespace stewart

@@ -1,5 +1,7 @@
 #include "stewart/plant_sim/actuator_model.h"
 
+#include "stewart/model/dynamics.h"
+
 namespace stewart {
 
 Vector6d SaturateForce(const ActuatorConfig& actuators, const Vector6d& force_cmd_n) {
@@ -8,7 +10,7 @@ Vector6d SaturateForce(const ActuatorConfig& actuators, const Vector6d& force_cm
 }
 
 Vector6d FrictionForce(const ActuatorConfig& actuators, const Vector6d& leg_speed_mps) {
-  return -actuators.viscous_friction_nspm * leg_speed_mps;
+  return LegViscousFriction(actuators.viscous_friction_nspm, leg_speed_mps);
 }
 
 Vector6d EndStopForce(const ActuatorConfig& actuators, const Vector6d& leg_length_m,

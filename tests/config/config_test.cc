@@ -81,6 +81,27 @@ TEST(Config, WrongType) {
                     "safety.position_limits[0].axis", "not one of");
 }
 
+TEST(Config, CorrectionMetricAndFrictionModel) {
+  const StackConfig c = LoadStackConfig(DefaultConfigPath());
+  EXPECT_EQ(c.safety.correction_metric, CorrectionMetric::kAcceleration);
+  // One friction coefficient: the actuators'.
+  EXPECT_GT(c.actuators.viscous_friction_nspm, 0.0);
+  EXPECT_EQ(c.controller.leg_friction_nspm, c.actuators.viscous_friction_nspm);
+  EXPECT_EQ(c.safety.leg_friction_nspm, c.actuators.viscous_friction_nspm);
+  YAML::Node yaml = DefaultYaml();
+  yaml["controller"]["compensate_friction"] = false;
+  yaml["safety"]["model_leg_friction"] = false;
+  yaml["safety"].remove("correction_metric");  // optional: the paper's force metric
+  const StackConfig off = ParseStackConfig(Emit(yaml));
+  EXPECT_EQ(off.controller.leg_friction_nspm, 0.0);
+  EXPECT_EQ(off.safety.leg_friction_nspm, 0.0);
+  EXPECT_EQ(off.safety.correction_metric, CorrectionMetric::kForce);
+  ExpectConfigError([](YAML::Node& y) { y["safety"]["correction_metric"] = "energy"; },
+                    "safety.correction_metric", "not one of");
+  ExpectConfigError([](YAML::Node& y) { y["controller"]["compensate_friction"] = "yes please"; },
+                    "controller.compensate_friction", "true or false");
+}
+
 TEST(Config, NotANumber) {
   ExpectConfigError([](YAML::Node& y) { y["platform"]["mass_kg"] = ".nan"; }, "platform.mass_kg",
                     "finite");

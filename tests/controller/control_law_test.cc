@@ -62,15 +62,22 @@ TEST(ControlLaw, SolvesTheDynamicsEquation) {
   const Vector6d f = NominalForce(c.platform, c.controller, q, qd, sp, &terms);
   const Vector6d u = PdAcceleration(c.controller, q, qd, sp);
   const Vector6d rhs = terms.M * u + terms.C_qd + terms.G;
-  EXPECT_LT((terms.H * f - rhs).norm(), 1e-9 * rhs.norm());
-  // And the model, driven by F_des, accelerates by u.
-  EXPECT_LT((ForwardDynamics(terms, f) - u).norm(), 1e-9 * u.norm());
+  // The legs lose the viscous friction on the way (compensate_friction).
+  ASSERT_GT(c.controller.leg_friction_nspm, 0.0);
+  const Vector6d f_leg =
+      f + LegViscousFriction(c.controller.leg_friction_nspm, terms.H.transpose() * qd);
+  ASSERT_GT((f_leg - f).norm(), 1e-6);  // the state moves: friction matters here
+  EXPECT_LT((terms.H * f_leg - rhs).norm(), 1e-9 * rhs.norm());
+  // And the model, driven by the net leg force, accelerates by u.
+  EXPECT_LT((ForwardDynamics(terms, f_leg) - u).norm(), 1e-9 * u.norm());
 }
 
-// Classic RK4 of qdd = M^-1 (H F - C qd - G) with F held over the step.
-void Rk4Step(const PlatformParams& p, const Vector6d& f, double dt, Vector6d* q, Vector6d* qd) {
+// Classic RK4 of the plant qdd = M^-1 (H (F - b H^T qd) - C qd - G), F held over the step.
+void Rk4Step(const PlatformParams& p, double b, const Vector6d& f, double dt, Vector6d* q,
+             Vector6d* qd) {
   auto accel = [&](const Vector6d& qa, const Vector6d& qda) {
-    return ForwardDynamics(EvaluateDynamics(p, qa, qda), f);
+    const DynamicsTerms t = EvaluateDynamics(p, qa, qda);
+    return ForwardDynamics(t, f + LegViscousFriction(b, t.H.transpose() * qda));
   };
   const Vector6d k1q = *qd, k1v = accel(*q, *qd);
   const Vector6d k2q = *qd + 0.5 * dt * k1v, k2v = accel(*q + 0.5 * dt * k1q, k2q);
@@ -92,7 +99,7 @@ TEST(ControlLaw, ClosedLoopConvergesToAReachableSetpoint) {
   for (int k = 0; k < 4000; ++k) {  // 4 s, gains kp 25, kd 10: critically damped, w = 5/s
     const Vector6d f = NominalForce(c.platform, c.controller, q, qd, sp, &terms);
     ASSERT_TRUE(f.allFinite());
-    Rk4Step(c.platform, f, dt, &q, &qd);
+    Rk4Step(c.platform, c.actuators.viscous_friction_nspm, f, dt, &q, &qd);
     max_overshoot_m = std::max(max_overshoot_m, q(2) - target(2));
   }
   // Error ~ (1 + w t) e^{-w t} of 0.1 at 4 s: 4e-8 (plus the ZOH's small effect).

@@ -9,9 +9,10 @@
 namespace stewart::safety::test {
 namespace {
 
-void CheckKkt(bool force_limits) {
+void CheckKkt(bool force_limits, CorrectionMetric metric) {
   SafetyConfig config = RichSafetyConfig();
   config.force_limits_enabled = force_limits;
+  config.correction_metric = metric;
   SafetyFilter filter(DefaultConfig().platform, config, DefaultConfig().actuators);
   const double f_max = DefaultConfig().actuators.force_limit_n;
   std::mt19937 rng(force_limits ? 23 : 29);
@@ -29,8 +30,18 @@ void CheckKkt(bool force_limits) {
     if (d.mu_p > 0 || d.mu_v > 0) ++active;
     const BarrierEvaluation& b = d.barriers;
     const double scale = f.norm() + f_des.norm() + 1.0;
-    // Stationarity.
-    const Vector6d residual = f - f_des - d.mu_p * b.g_p - d.mu_v * b.g_v + d.mu_force;
+    // Stationarity of (F - F_des)^T W (F - F_des): F - F_des = W^-1 (mu_p g_p + mu_v g_v -
+    // mu_force), with W^-1 = T T^T, T = I for the force metric.
+    const Matrix6d& t = b.metric_map;
+    if (metric == CorrectionMetric::kForce) {
+      EXPECT_EQ(t, Matrix6d::Identity());
+    } else {
+      // T T^T is W^-1 = (H^T M^-1 H)^-1.
+      const Matrix6d w = terms.H.transpose() * terms.M.inverse() * terms.H;
+      EXPECT_LE((t * t.transpose() * w - Matrix6d::Identity()).norm(), 1e-8) << "sample " << n;
+    }
+    const Vector6d residual =
+        f - f_des - t * t.transpose() * (d.mu_p * b.g_p + d.mu_v * b.g_v - d.mu_force);
     EXPECT_LE(residual.norm(), 1e-10 * scale) << "sample " << n;
     // Dual feasibility.
     EXPECT_GE(d.mu_p, 0.0);
@@ -60,8 +71,10 @@ void CheckKkt(bool force_limits) {
   EXPECT_GT(active, 1000);
 }
 
-TEST(Kkt, ClosedForm) { CheckKkt(false); }
-TEST(Kkt, ForceLimited) { CheckKkt(true); }
+TEST(Kkt, ClosedForm) { CheckKkt(false, CorrectionMetric::kForce); }
+TEST(Kkt, ForceLimited) { CheckKkt(true, CorrectionMetric::kForce); }
+TEST(Kkt, ClosedFormAccelerationMetric) { CheckKkt(false, CorrectionMetric::kAcceleration); }
+TEST(Kkt, ForceLimitedAccelerationMetric) { CheckKkt(true, CorrectionMetric::kAcceleration); }
 
 }  // namespace
 }  // namespace stewart::safety::test

@@ -7,6 +7,11 @@ namespace stewart {
 struct ControllerConfig {
   Vector6d kp = Vector6d::Zero();  ///< 1/s^2
   Vector6d kd = Vector6d::Zero();  ///< 1/s
+  /// Optional key `compensate_friction` (default true): F_des also cancels
+  /// the legs' viscous friction, leg_friction_nspm = actuators.viscous_friction_nspm
+  /// (set by ParseStackConfig), else 0.
+  bool compensate_friction = true;
+  double leg_friction_nspm = 0.0;  ///< N per m/s of leg speed
 };
 
 ControllerConfig ParseControllerConfig(const ConfigNode& controller);

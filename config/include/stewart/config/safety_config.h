@@ -32,6 +32,13 @@ struct LegStrokeLimitConfig {
 enum class SafetyVariant { kClosedForm, kPaperRule, kQpReference };
 enum class SafetyFallback { kHold, kZero };
 
+/// How the filter measures the size of its correction F* - F_des
+/// (docs/safety.md, "Correction metric"):
+///   kForce:        ||F - F_des||^2                   (the paper's QP)
+///   kAcceleration: (qdd - qdd_des)^T M (qdd - qdd_des)
+///                  = (F - F_des)^T H^T M^-1 H (F - F_des)   (Gauss's least constraint)
+enum class CorrectionMetric { kForce, kAcceleration };
+
 /// `safety`: the CBF filter's constraints and parameters.
 struct SafetyConfig {
   SafetyVariant variant = SafetyVariant::kClosedForm;
@@ -46,10 +53,19 @@ struct SafetyConfig {
   /// Time constant of the "hold" safe stop: qdd = -qd / stop_time_s (s).
   /// Optional key, default 0.2 s.
   double stop_time_s = 0.2;
+  /// Optional key `correction_metric` (force | acceleration), default force.
+  CorrectionMetric correction_metric = CorrectionMetric::kForce;
+  /// Viscous leg friction the filter's dynamics include (N per m/s of leg
+  /// speed): actuators.viscous_friction_nspm when the optional key
+  /// `model_leg_friction` is true (default), else 0. Set by ParseStackConfig.
+  bool model_leg_friction = true;
+  double leg_friction_nspm = 0.0;
 };
 
 SafetyConfig ParseSafetyConfig(const ConfigNode& safety);
 std::string ToString(SafetyVariant variant);
 SafetyVariant ParseSafetyVariant(const std::string& name);  ///< throws std::invalid_argument
+std::string ToString(CorrectionMetric metric);
+CorrectionMetric ParseCorrectionMetric(const std::string& name);  ///< throws std::invalid_argument
 
 }  // namespace stewart

@@ -4,8 +4,10 @@
 // Paper eq. 3 (commanded task-space acceleration, 1/s^2 and 1/s gains):
 //   u = qdd_des - Kp (q - q_des) - Kd (qd - qd_des)
 // and the leg forces that realise it through the model of paper eq. 2:
-//   H(q) F_des = M(q) u + C(q, qd) qd + G(q)
-// solved by the model's InverseDynamics (no second copy of the dynamics).
+//   H(q) (F_des + F_friction) = M(q) u + C(q, qd) qd + G(q)
+// solved by the model's InverseDynamics (no second copy of the dynamics);
+// F_friction = LegViscousFriction(gains.leg_friction_nspm, H^T qd) is the
+// legs' own viscous friction, cancelled when the config says so.
 #include "stewart/config/controller_config.h"
 #include "stewart/controller/setpoint.h"
 #include "stewart/model/dynamics.h"

@@ -37,6 +37,16 @@ Vector6d ForwardDynamics(const DynamicsTerms& terms, const Vector6d& force_n);
 /// singular poses; a least-squares answer is returned there).
 Vector6d InverseDynamics(const DynamicsTerms& terms, const Vector6d& qdd);
 
+/// Viscous friction of the legs' lead screws, as leg forces (N):
+///   F_friction = -b ld,   ld = J_l qd = H^T qd  (leg speed, m/s; b in N s/m).
+/// The legs push with F + F_friction, so the plant obeys
+///   M qdd + C qd + G = H (F - b H^T qd).
+/// plant_sim integrates it; the controller and the filter include it in
+/// their model of the plant (docs/model.md, "Leg friction").
+inline Vector6d LegViscousFriction(double b_nspm, const Vector6d& leg_speed_mps) {
+  return -b_nspm * leg_speed_mps;
+}
+
 /// Kinetic energy 1/2 qd^T M qd (J).
 double KineticEnergy(const DynamicsTerms& terms, const Vector6d& qd);
 

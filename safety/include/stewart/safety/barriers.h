@@ -37,6 +37,11 @@ struct BarrierEvaluation {
   double psi_v = 0.0;               ///< Psi_v(F_des) (m/s^2)
   Vector6d g_p = Vector6d::Zero();  ///< dPsi_p/dF (W/N = m/s)
   Vector6d g_v = Vector6d::Zero();  ///< dPsi_v/dF (m/s^2 per N)
+  /// T of the correction metric (SafetyFilter; docs/safety.md): with
+  /// F = T y the cost (F - F_des)^T W (F - F_des) is ||y - y_des||^2, W^-1 = T T^T.
+  /// Identity for the force metric; H^-1 L_M (M = L_M L_M^T) for the
+  /// acceleration metric.
+  Matrix6d metric_map = Matrix6d::Identity();
 };
 
 /// Evaluates every barrier and the two composed conditions at (q, qd, F_des)

@@ -1,8 +1,12 @@
 #pragma once
 // The CBF safety filter (docs/safety.md):
 //
-//   F* = argmin ||F - F_des||^2  s.t.  Psi_p(F) >= 0, Psi_v(F) >= 0
-//                                      [, |F_i| <= F_max]
+//   F* = argmin (F - F_des)^T W (F - F_des)  s.t.  Psi_p(F) >= 0, Psi_v(F) >= 0
+//                                                  [, |F_i| <= F_max]
+//
+// W = I (the paper's force metric) or H^T M^-1 H (acceleration metric). The
+// conditions use the model of the plant including the legs' viscous friction
+// when configured: the legs push with F + LegViscousFriction(b, H^T qd).
 //
 // Typical use in a node (no heap allocation per step):
 //   SafetyFilter filter(config.platform, config.safety, config.actuators);
@@ -41,8 +45,11 @@ class SafetyFilter {
   /// force if the state itself is not finite.
   Vector6d SafeStopCommand(const Vector6d& q, const Vector6d& qd, SafetyDiagnostics* diagnostics);
 
-  /// The QP the filter solves at this step, as posed to the reference solver
-  /// (CBF rows scaled to unit normals; box rows when force limits are on).
+  /// The QP the filter solves at this step, as posed to the reference solver:
+  /// in the metric's coordinates y = T^-1 F (T = barriers.metric_map, so
+  /// ||y - y0||^2 is the metric's cost; y = F for the force metric), CBF rows
+  /// scaled to unit normals, box rows when force limits are on. Map a
+  /// solution back with ForceFromQpSolution.
   /// Absent rows are left out; returns false when a CBF row has a zero
   /// normal (it cannot be posed).
   struct QpRows {
@@ -53,16 +60,24 @@ class SafetyFilter {
   bool BuildQp(const BarrierEvaluation& barriers, const Vector6d& f_des, ProjectionQp* qp,
                QpRows* rows = nullptr) const;
 
+  /// F = T y for a solution y of the QP from BuildQp.
+  static Vector6d ForceFromQpSolution(const BarrierEvaluation& barriers, const Vector6d& y) {
+    return barriers.metric_map * y;
+  }
+
   void set_variant(SafetyVariant variant);
   SafetyVariant variant() const { return variant_; }
   void set_force_limits(bool enabled) { force_limits_ = enabled; }
   bool force_limits() const { return force_limits_; }
   const ConstraintSet& constraints() const { return constraints_; }
+  CorrectionMetric correction_metric() const { return metric_; }
+  double leg_friction_nspm() const { return leg_friction_nspm_; }
   double force_limit_n() const { return force_limit_n_; }
 
  private:
   Vector6d SafeStop(const DynamicsTerms& terms, const Vector6d& qd, bool terms_valid) const;
-  void SolveUnlimited(const BarrierEvaluation& b, SafetyDiagnostics* d) const;
+  void SolveUnlimited(const BarrierEvaluation& b, const Vector6d& f_des,
+                      SafetyDiagnostics* d) const;
   void SolveForceLimited(const DynamicsTerms& terms, const Vector6d& qd, const BarrierEvaluation& b,
                          const Vector6d& f_des, SafetyDiagnostics* d) const;
   void SolveReference(const BarrierEvaluation& b, const Vector6d& f_des,
@@ -71,6 +86,8 @@ class SafetyFilter {
   PlatformParams platform_;
   ConstraintSet constraints_;
   SafetyVariant variant_;
+  CorrectionMetric metric_;
+  double leg_friction_nspm_;
   bool force_limits_;
   double force_limit_n_;
   SafetyFallback fallback_;

@@ -1,0 +1,169 @@
+#include "closed_loop.h"
+
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include "stewart/controller/controller.h"
+#include "stewart/estimator/ekf.h"
+#include "stewart/plant_sim/plant.h"
+#include "stewart/plant_sim/sensor_model.h"
+#include "stewart/safety/safety_filter.h"
+
+namespace stewart {
+namespace {
+
+OdeOptions OdeOptionsOf(const PlantSimConfig& c) {
+  OdeOptions o;
+  o.method = ParseOdeMethod(c.integrator);
+  o.rel_tol = c.rel_tol;
+  o.abs_tol = c.abs_tol;
+  return o;
+}
+
+void TrackLimitExcess(const SafetyConfig& s, const Vector6d& q, const Vector6d& qd,
+                      ClosedLoopSummary* out) {
+  auto consider = [&](double excess, int axis, const char* what) {
+    if (excess > out->max_limit_excess) {
+      out->max_limit_excess = excess;
+      out->max_limit_excess_name = std::string(kAxisNames[axis]) + what;
+    }
+  };
+  for (const PositionLimitConfig& l : s.position_limits) {
+    if (l.upper) consider(q(l.axis) - *l.upper, l.axis, " upper");
+    if (l.lower) consider(*l.lower - q(l.axis), l.axis, " lower");
+  }
+  for (const VelocityLimitConfig& l : s.velocity_limits) {
+    if (l.upper) consider(qd(l.axis) - *l.upper, l.axis, "d upper");
+    if (l.lower) consider(*l.lower - qd(l.axis), l.axis, "d lower");
+  }
+}
+
+}  // namespace
+
+ClosedLoopSummary RunClosedLoop(const StackConfig& config, const Scenario& scenario,
+                                const ClosedLoopOptions& options, std::ostream* csv) {
+  SensorConfig sensors = config.sensors;
+  sensors.seed = static_cast<unsigned>(options.seed);
+  Plant plant(PlantModel{config.platform, config.actuators}, OdeOptionsOf(config.plant_sim));
+  plant.Reset(0.0, config.plant_sim.initial_pose, config.plant_sim.initial_velocity);
+  SensorModel sensor_model(sensors, config.actuators, config.platform.gravity_mps2);
+  Ekf ekf(config.platform, config.actuators, sensors, config.estimator, config.home_pose);
+  Controller controller(config.platform, config.controller, config.home_pose, scenario);
+  safety::SafetyFilter filter(config.platform, config.safety, config.actuators);
+
+  const std::int64_t period_us = std::llround(1e6 / sensors.rate_hz);
+  const long ticks = std::lround(options.duration_s * 1e6 / static_cast<double>(period_us));
+  ClosedLoopSummary out;
+  double sq_q = 0.0, sq_qd = 0.0;
+  long estimated_ticks = 0;
+  if (csv) {
+    *csv << "t";
+    for (const char* prefix : {"q_", "qd_", "qest_", "qdest_"})
+      for (const std::string_view a : kAxisNames) *csv << ',' << prefix << a;
+    for (const char* prefix : {"fdes_", "fsafe_"})
+      for (int i = 1; i <= 6; ++i) *csv << ',' << prefix << i;
+    *csv << ",case,h_pos,h_vel\n";
+  }
+  for (long k = 0; k < ticks; ++k) {
+    const std::int64_t utime = k * period_us;
+    const Vector6d q_true = plant.q(), qd_true = plant.qd();
+    const PlantRates& rates = plant.EvaluateRates();
+    const SensorReading r =
+        sensor_model.Sample(q_true, qd_true, rates.x_dot.segment<6>(6), rates.terms.leg_length_m);
+    Vector6d q = q_true, qd = qd_true;
+    if (!options.perfect_state) {
+      SensorSample sample;
+      sample.utime = utime;
+      sample.leg_length_m = r.leg_length_m;
+      sample.gyro_radps = r.gyro_radps;
+      sample.accel_mps2 = r.accel_mps2;
+      sample.has_orientation = r.has_orientation;
+      sample.orientation_rpy_rad = r.orientation_rpy_rad;
+      const UpdateResult u = ekf.Update(sample);
+      if (u.Has(kEventInitialized) && k > 0) ++out.estimator_reinits;
+      if (!u.has_estimate) {
+        plant.Advance(static_cast<double>(period_us) * 1e-6);
+        continue;
+      }
+      const Estimate e = ekf.estimate();
+      q = e.q;
+      qd = e.qd;
+      sq_q += (q - q_true).head<3>().squaredNorm();
+      sq_qd += (qd - qd_true).head<3>().squaredNorm();
+      ++estimated_ticks;
+    }
+    ControllerOutput c;
+    Vector6d f_safe = Vector6d::Zero();
+    safety::SafetyDiagnostics d;
+    if (controller.Step(utime, q, qd, &c) == StepStatus::kOk) {
+      f_safe = options.no_filter ? c.force_n : filter.Step(q, qd, c.force_n, &d);
+    } else {
+      f_safe = filter.SafeStopCommand(q, qd, &d);
+    }
+    ++out.case_ticks[static_cast<int>(d.filter_case)];
+    if (d.infeasible) ++out.infeasible_ticks;
+    const double f_max = f_safe.cwiseAbs().maxCoeff();
+    out.max_force_n = std::max(out.max_force_n, f_max);
+    if (f_max > config.actuators.force_limit_n) ++out.saturated_ticks;
+    if (!options.perfect_state) ekf.SetForceCommand(utime, f_safe);
+    if (csv) {
+      *csv << static_cast<double>(utime) * 1e-6;
+      const std::array<const Vector6d*, 6> columns{&q_true, &qd_true, &q, &qd, &c.force_n, &f_safe};
+      for (const Vector6d* v : columns)
+        for (int i = 0; i < 6; ++i) *csv << ',' << (*v)(i);
+      *csv << ',' << static_cast<int>(d.filter_case) << ',' << d.barriers.h_pos << ','
+           << d.barriers.h_vel << '\n';
+    }
+    plant.SetForceCommand(f_safe);
+    plant.Advance(static_cast<double>(period_us) * 1e-6);
+    const Vector6d q1 = plant.q(), qd1 = plant.qd();
+    out.q_max = out.q_max.cwiseMax(q1);
+    out.q_min = out.q_min.cwiseMin(q1);
+    out.qd_max = out.qd_max.cwiseMax(qd1);
+    out.qd_min = out.qd_min.cwiseMin(qd1);
+    TrackLimitExcess(config.safety, q1, qd1, &out);
+    ++out.ticks;
+    if (!q1.allFinite() || !qd1.allFinite()) return out;
+  }
+  out.q_final = plant.q();
+  if (estimated_ticks > 0) {
+    out.rms_q_error = std::sqrt(sq_q / static_cast<double>(estimated_ticks));
+    out.rms_qd_error = std::sqrt(sq_qd / static_cast<double>(estimated_ticks));
+  }
+  out.completed = true;
+  return out;
+}
+
+std::string FormatSummary(const StackConfig& config, const ClosedLoopSummary& s) {
+  std::ostringstream o;
+  char line[256];
+  o << "axis      q_min      q_max   limit |    qd_min     qd_max   limit\n";
+  for (int a = 0; a < 6; ++a) {
+    std::string pos_limit = "-", vel_limit = "-";
+    for (const PositionLimitConfig& l : config.safety.position_limits)
+      if (l.axis == a && l.upper) pos_limit = std::to_string(*l.upper).substr(0, 6);
+    for (const VelocityLimitConfig& l : config.safety.velocity_limits)
+      if (l.axis == a && l.upper) vel_limit = std::to_string(*l.upper).substr(0, 6);
+    std::snprintf(line, sizeof line, "%-5s %10.5f %10.5f %7s | %9.5f %10.5f %7s\n",
+                  std::string(kAxisNames[a]).c_str(), s.q_min(a), s.q_max(a), pos_limit.c_str(),
+                  s.qd_min(a), s.qd_max(a), vel_limit.c_str());
+    o << line;
+  }
+  std::snprintf(line, sizeof line,
+                "worst excess %.3g (%s); ticks %ld; cases none/p/v/both/infeasible/fallback "
+                "%ld/%ld/%ld/%ld/%ld/%ld; saturated ticks %ld, max |F*| %.1f N\n",
+                s.max_limit_excess, s.max_limit_excess_name.c_str(), s.ticks, s.case_ticks[0],
+                s.case_ticks[1], s.case_ticks[2], s.case_ticks[3], s.case_ticks[4], s.case_ticks[5],
+                s.saturated_ticks, s.max_force_n);
+  o << line;
+  std::snprintf(line, sizeof line,
+                "estimator: rms |q-q_true| %.3g m, rms |qd-qd_true| %.3g m/s, re-inits %ld; "
+                "final q [%.4f %.4f %.4f %.4f %.4f %.4f]\n",
+                s.rms_q_error, s.rms_qd_error, s.estimator_reinits, s.q_final(0), s.q_final(1),
+                s.q_final(2), s.q_final(3), s.q_final(4), s.q_final(5));
+  o << line;
+  return o.str();
+}
+
+}  // namespace stewart
