@@ -97,6 +97,12 @@ SafetyConfig ParseSafetyConfig(const ConfigNode& safety) {
     s.correction_metric =
         ParseCorrectionMetric(safety.Choice("correction_metric", {"force", "acceleration"}));
   }
+  if (safety.Has("velocity_robust_margin_mps2")) {
+    s.velocity_robust_margin_mps2 = safety.NonNegativeDouble("velocity_robust_margin_mps2");
+  }
+  if (safety.Has("position_robust_margin_w")) {
+    s.position_robust_margin_w = safety.NonNegativeDouble("position_robust_margin_w");
+  }
   if (safety.Has("model_leg_friction")) s.model_leg_friction = safety.Bool("model_leg_friction");
   return s;
 }

@@ -131,6 +131,8 @@ void Ekf::Predict(double dt_s, int64_t utime, uint32_t* events) {
                                   &qdd_, &A, &B);
     phi.bottomLeftCorner<6, 6>() = dt_s * A;
     phi.bottomRightCorner<6, 6>() += dt_s * B;
+    dqdd_dq_ = A;
+    dqdd_dqd_ = B;
     sigma_lin = config_.dynamics_accel_std_mps2;
     sigma_ang = config_.dynamics_angaccel_std_radps2;
   } else {
@@ -203,7 +205,19 @@ void Ekf::CorrectAccel(const Vector3d& accel_mps2, uint32_t* events) {
   // The predicted qdd is uncertain by the process model's acceleration noise.
   const double sigma =
       qdd_from_dynamics_ ? config_.dynamics_accel_std_mps2 : config_.process_accel_std_mps2;
-  const Matrix3d R = Matrix3d::Identity() * (accel_variance_ + sigma * sigma);
+  Matrix3d R = Matrix3d::Identity() * (accel_variance_ + sigma * sigma);
+  if (qdd_from_dynamics_) {
+    // ... and by the state's: the dynamics model's qdd depends on q and qd
+    // (friction, Coriolis, gravity). Added to the noise, not to H, so the
+    // accelerometer does not correct the pose through the dynamics; without
+    // it the innovation covariance ignores the velocity's uncertainty and
+    // right after an initialisation good samples are gated.
+    Eigen::Matrix<double, 3, 12> d_state;
+    const Eigen::Matrix<double, 3, 6> d =
+        AccelQddJacobian(x_, qdd_, imu_offset_m_, params_.gravity_mps2);
+    d_state << d * dqdd_dq_, d * dqdd_dqd_;
+    R += d_state * P_.topLeftCorner<12, 12>() * d_state.transpose();
+  }
   double nis = 0.0;
   if (!Correct<3>(accel_mps2 - predicted, H, R, &nis)) *events |= kGateAccel;
 }

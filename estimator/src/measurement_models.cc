@@ -68,6 +68,20 @@ void PredictAccel(const EkfVector& x, const Vector6d& qdd, const Vector3d& imu_o
   CentralDifference(x, kEkfQd + 3, 3, h, jacobian);
 }
 
+Eigen::Matrix<double, 3, 6> AccelQddJacobian(const EkfVector& x, const Vector6d& qdd,
+                                             const Vector3d& imu_offset_m, double gravity_mps2) {
+  Eigen::Matrix<double, 3, 6> d;
+  const Vector6d q = x.segment<6>(kEkfQ), qd = x.segment<6>(kEkfQd);
+  // Affine in qdd: a unit difference is exact.
+  const Vector3d base = ImuSpecificForce(q, qd, qdd, imu_offset_m, gravity_mps2);
+  for (int i = 0; i < 6; ++i) {
+    Vector6d e = qdd;
+    e(i) += 1.0;
+    d.col(i) = ImuSpecificForce(q, qd, e, imu_offset_m, gravity_mps2) - base;
+  }
+  return d;
+}
+
 double WrapAngle(double angle_rad) { return std::remainder(angle_rad, 2.0 * M_PI); }
 
 }  // namespace stewart

@@ -36,7 +36,7 @@ void EvaluateBarriers(const ConstraintSet& c, const Vector6d& q, const Vector6d&
       sum_alpha_w += alpha_w;
       psi += alpha_w * e.dh_position[static_cast<size_t>(i)];
     }
-    e.psi_p = psi;
+    e.psi_p = psi - c.position_margin;
     e.g_p = -sum_alpha_w * leg_rate;
   } else {
     e.h_pos = e.psi_p = 0.0;
@@ -62,7 +62,7 @@ void EvaluateBarriers(const ConstraintSet& c, const Vector6d& q, const Vector6d&
       a_c(s.axis) += alpha_w * s.sign;
       psi += alpha_w * e.dh_velocity[static_cast<size_t>(i)];
     }
-    e.psi_v = psi;
+    e.psi_v = psi - c.velocity_margin;
     e.g_v = terms.H.transpose() * llt.solve(a_c);
   } else {
     e.h_vel = e.psi_v = 0.0;

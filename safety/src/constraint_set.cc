@@ -16,6 +16,10 @@ ConstraintSet BuildConstraintSet(const PlatformParams& platform, const SafetyCon
   Require(safety.k_position > 0.0 && safety.k_velocity > 0.0, "k must be positive");
   c.k_position = safety.k_position;
   c.k_velocity = safety.k_velocity;
+  Require(safety.position_robust_margin_w >= 0.0 && safety.velocity_robust_margin_mps2 >= 0.0,
+          "robust margins must be >= 0");
+  c.position_margin = safety.position_robust_margin_w;
+  c.velocity_margin = safety.velocity_robust_margin_mps2;
   auto add_position = [&](PositionSource source, int index, double sign, double limit,
                           double alpha_e, double alpha, const std::string& name) {
     Require(c.num_position < kMaxPositionBarriers, "too many position limits (axis listed twice?)");

@@ -52,9 +52,9 @@ StackConfig WithModel(EstimatorProcessModel model, bool accel = true) {
   return c;
 }
 
-TEST(EkfAccuracy, DefaultConfigIsConstantVelocityAndNotPerfectState) {
-  EXPECT_EQ(EstimatorTestConfig().estimator.process_model,
-            EstimatorProcessModel::kConstantVelocity);
+TEST(EkfAccuracy, DefaultConfigIsDynamicsAndNotPerfectState) {
+  // Chosen in the closed loop (docs/estimator.md, "Choice of process model").
+  EXPECT_EQ(EstimatorTestConfig().estimator.process_model, EstimatorProcessModel::kDynamics);
   EXPECT_FALSE(EstimatorTestConfig().estimator.perfect_state);
 }
 

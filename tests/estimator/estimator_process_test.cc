@@ -168,7 +168,12 @@ TEST(EstimatorProcess, EstimatesCarryTheSensorSampleUtime) {
   ASSERT_TRUE(PumpUntil(
       lcm.get(), [&] { return sink.health.back().messages_in >= 2 * kSamples; }, 5.0));
   const health_t& h = sink.health.back();
-  EXPECT_EQ(h.rejected_inputs, 2);
+  std::string counters;
+  for (int i = 0; i < h.num_counters; ++i) {
+    counters += h.counter_names[static_cast<size_t>(i)] + "=" +
+                std::to_string(h.counter_values[static_cast<size_t>(i)]) + " ";
+  }
+  EXPECT_EQ(h.rejected_inputs, 2) << counters;
   EXPECT_EQ(Counter(h, "rejected_legs_non_finite"), 1);
   EXPECT_EQ(Counter(h, "rejected_non_increasing_time"), 1);
   EXPECT_EQ(h.messages_out, kSamples);

@@ -88,3 +88,54 @@ TEST(BarrierGradient, PositionNormalIsMinusHTransposeQdAtRest) {
 
 }  // namespace
 }  // namespace stewart::safety::test
+
+namespace stewart::safety::test {
+namespace {
+
+TEST(RobustMarginAndFriction, ShiftPsiExactlyAndTheFilterKeepsTheMargin) {
+  SafetyConfig plain = RichSafetyConfig();
+  plain.leg_friction_nspm = 0.0;
+  SafetyConfig robust = plain;
+  robust.velocity_robust_margin_mps2 = 0.004;
+  robust.position_robust_margin_w = 0.03;
+  SafetyConfig friction = plain;
+  friction.leg_friction_nspm = 3.0;
+  SafetyFilter f_plain(DefaultConfig().platform, plain, DefaultConfig().actuators);
+  SafetyFilter f_robust(DefaultConfig().platform, robust, DefaultConfig().actuators);
+  SafetyFilter f_friction(DefaultConfig().platform, friction, DefaultConfig().actuators);
+  std::mt19937 rng(5);
+  int robust_active_only = 0;
+  for (int n = 0; n < 2000; ++n) {
+    const Vector6d q = RandomPoseInLimits(&rng);
+    const Vector6d qd = RandomVelocity(&rng);
+    const DynamicsTerms terms = EvaluateDynamics(DefaultConfig().platform, q, qd);
+    const Vector6d f_des = RandomNominalForce(terms, &rng);
+    SafetyDiagnostics dp, dr, df, dshift;
+    f_plain.StepWithTerms(terms, q, qd, f_des, &dp);
+    const Vector6d f_r = f_robust.StepWithTerms(terms, q, qd, f_des, &dr);
+    EXPECT_NEAR(dr.barriers.psi_v, dp.barriers.psi_v - 0.004, 1e-12);
+    EXPECT_NEAR(dr.barriers.psi_p, dp.barriers.psi_p - 0.03, 1e-12);
+    if (!dr.infeasible) {
+      // At F* the conditions hold with the margin.
+      EXPECT_GE(dp.barriers.psi_v + dp.barriers.g_v.dot(f_r - f_des), 0.004 - 1e-9);
+      EXPECT_GE(dp.barriers.psi_p + dp.barriers.g_p.dot(f_r - f_des), 0.03 - 1e-9);
+    }
+    if (dp.filter_case == FilterCase::kNone && dr.filter_case != FilterCase::kNone) {
+      ++robust_active_only;
+    }
+    // Friction: the conditions are those of the frictionless model at the
+    // force the legs really push, F - b H^T qd.
+    const Vector6d friction_n = LegViscousFriction(3.0, terms.H.transpose() * qd);
+    const Vector6d f_f = f_friction.StepWithTerms(terms, q, qd, f_des, &df);
+    const Vector6d f_shift = f_plain.StepWithTerms(terms, q, qd, f_des + friction_n, &dshift);
+    EXPECT_NEAR(df.barriers.psi_v, dshift.barriers.psi_v,
+                1e-9 * (1 + std::fabs(df.barriers.psi_v)));
+    EXPECT_NEAR(df.barriers.psi_p, dshift.barriers.psi_p,
+                1e-9 * (1 + std::fabs(df.barriers.psi_p)));
+    EXPECT_LE((f_f + friction_n - f_shift).norm(), 1e-9 * (1 + f_shift.norm())) << "sample " << n;
+  }
+  EXPECT_GT(robust_active_only, 10);  // the margin made the filter act where it did not
+}
+
+}  // namespace
+}  // namespace stewart::safety::test

@@ -72,6 +72,7 @@ ClosedLoopSummary RunClosedLoop(const StackConfig& config, const Scenario& scena
     const SensorReading r =
         sensor_model.Sample(q_true, qd_true, rates.x_dot.segment<6>(6), rates.terms.leg_length_m);
     Vector6d q = q_true, qd = qd_true;
+    bool state_trusted = true;  // as the safety process: only STATUS_VALID states are filtered
     if (!options.perfect_state) {
       SensorSample sample;
       sample.utime = utime;
@@ -89,6 +90,7 @@ ClosedLoopSummary RunClosedLoop(const StackConfig& config, const Scenario& scena
       const Estimate e = ekf.estimate();
       q = e.q;
       qd = e.qd;
+      state_trusted = !e.initializing && !e.diverged;
       sq_q += (q - q_true).head<3>().squaredNorm();
       sq_qd += (qd - qd_true).head<3>().squaredNorm();
       ++estimated_ticks;
@@ -96,7 +98,7 @@ ClosedLoopSummary RunClosedLoop(const StackConfig& config, const Scenario& scena
     ControllerOutput c;
     Vector6d f_safe = Vector6d::Zero();
     safety::SafetyDiagnostics d;
-    if (controller.Step(utime, q, qd, &c) == StepStatus::kOk) {
+    if (controller.Step(utime, q, qd, &c) == StepStatus::kOk && state_trusted) {
       f_safe = options.no_filter ? c.force_n : filter.Step(q, qd, c.force_n, &d);
     } else {
       f_safe = filter.SafeStopCommand(q, qd, &d);

@@ -59,6 +59,12 @@ struct SafetyConfig {
   /// speed): actuators.viscous_friction_nspm when the optional key
   /// `model_leg_friction` is true (default), else 0. Set by ParseStackConfig.
   bool model_leg_friction = true;
+  /// Robustness margins (optional keys, default 0): the conditions become
+  /// Psi_v >= velocity_robust_margin_mps2 and Psi_p >= position_robust_margin_w,
+  /// so a model or estimation error up to the margin (e.g. gravity through an
+  /// attitude error, g * 0.1 mrad = 1 mm/s^2) cannot hold the state outside.
+  double velocity_robust_margin_mps2 = 0.0;
+  double position_robust_margin_w = 0.0;
   double leg_friction_nspm = 0.0;
 };
 

@@ -69,6 +69,8 @@ class Ekf {
   EkfMatrix P_ = EkfMatrix::Identity();
   Vector6d qdd_ = Vector6d::Zero();
   bool qdd_from_dynamics_ = false;
+  Matrix6d dqdd_dq_ = Matrix6d::Zero();  ///< dynamics model, at the last predict
+  Matrix6d dqdd_dqd_ = Matrix6d::Zero();
   bool has_command_ = false;
   int64_t command_utime_ = 0;
   Vector6d command_n_ = Vector6d::Zero();

@@ -33,8 +33,8 @@ struct BarrierEvaluation {
   // Composed (zero when the group is empty).
   double h_pos = 0.0;               ///< composed position barrier (W)
   double h_vel = 0.0;               ///< composed velocity barrier (m/s^2)
-  double psi_p = 0.0;               ///< Psi_p(F_des) (W)
-  double psi_v = 0.0;               ///< Psi_v(F_des) (m/s^2)
+  double psi_p = 0.0;               ///< Psi_p(F_des) - position robust margin (W)
+  double psi_v = 0.0;               ///< Psi_v(F_des) - velocity robust margin (m/s^2)
   Vector6d g_p = Vector6d::Zero();  ///< dPsi_p/dF (W/N = m/s)
   Vector6d g_v = Vector6d::Zero();  ///< dPsi_v/dF (m/s^2 per N)
   /// T of the correction metric (SafetyFilter; docs/safety.md): with

@@ -47,6 +47,9 @@ struct ConstraintSet {
   std::array<VelocityBarrierSpec, kMaxVelocityBarriers> velocity;
   double k_position = 1.0;  ///< LSE sharpness of the position group (1/W)
   double k_velocity = 1.0;  ///< LSE sharpness of the velocity group (s^2/m)
+  /// Subtracted from psi_p (W) and psi_v (m/s^2): robustness margins.
+  double position_margin = 0.0;
+  double velocity_margin = 0.0;
 };
 
 /// Throws std::invalid_argument when the config holds more constraints than
