@@ -19,13 +19,14 @@ const StackConfig& Config() {
   return config;
 }
 
-void RunTicks(benchmark::State& state, OdeMethod method) {
+void RunTicks(benchmark::State& state, OdeMethod method, int erk_order = 5) {
   const StackConfig& c = Config();
   const PlantModel model{c.platform, c.actuators};
   OdeOptions o;
   o.method = method;
   o.rel_tol = c.plant_sim.rel_tol;
   o.abs_tol = c.plant_sim.abs_tol;
+  o.erk_order = erk_order;
   Plant plant(model, o);
   const Vector6d q0 = c.plant_sim.initial_pose;
   plant.Reset(0.0, q0, Vector6d::Zero());
@@ -56,6 +57,10 @@ void BM_PlantTick_ArkodeErk(benchmark::State& state) { RunTicks(state, OdeMethod
 void BM_PlantTick_CvodeBdf(benchmark::State& state) { RunTicks(state, OdeMethod::kCvodeBdf); }
 void BM_PlantTick_CvodeAdams(benchmark::State& state) { RunTicks(state, OdeMethod::kCvodeAdams); }
 BENCHMARK(BM_PlantTick_ArkodeErk);
+void BM_PlantTick_ArkodeErkOrder(benchmark::State& state) {
+  RunTicks(state, OdeMethod::kArkodeErk, static_cast<int>(state.range(0)));
+}
+BENCHMARK(BM_PlantTick_ArkodeErkOrder)->Arg(2)->Arg(3)->Arg(4)->Arg(6);
 BENCHMARK(BM_PlantTick_CvodeBdf);
 BENCHMARK(BM_PlantTick_CvodeAdams);
 
