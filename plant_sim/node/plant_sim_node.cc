@@ -179,6 +179,8 @@ int PlantSimNode::RunRealTime() {
                                             std::chrono::system_clock::now().time_since_epoch())
                                             .count();
   const auto period = std::chrono::microseconds(period_us_);
+  health_.SetCounter("overrun_ticks", 0);
+  health_.SetCounter("missed_ticks", 0);
   const Clock::time_point start = Clock::now();
   for (tick_ = 0;; ++tick_) {
     const Clock::time_point deadline = start + tick_ * period;
@@ -197,6 +199,15 @@ int PlantSimNode::RunRealTime() {
     while (lcm_->handleTimeout(0) > 0) {
     }
     if (StopRequested()) break;
+    // Real-time bookkeeping (docs/simulation.md, "Real-time figures"):
+    // an overrun is a tick started more than one period after its deadline
+    // (the simulator itself fell behind); a missed tick is one whose previous
+    // sample got no command before this tick, so the stale one stays applied.
+    if (Clock::now() - deadline > period) health_.Count("overrun_ticks");
+    if (tick_ > 0) {
+      const int64_t previous_sample_utime = utime0_ + (tick_ - 1) * period_us_;
+      if (last_applied_sample_utime_ < previous_sample_utime) health_.Count("missed_ticks");
+    }
     PublishSample();
     if (options_.duration_s > 0.0 && plant_.time_s() >= options_.duration_s - 1e-9) break;
     ApplyRealTimeDecision();
