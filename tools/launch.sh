@@ -24,11 +24,13 @@ usage: tools/launch.sh [options]
   --spy                 also open lcm-spy on the run's URL
   --lcm-url URL         use this URL instead of a private one
   --out DIR             run folder (default: runs/<date>-<scenario>)
+  --no-build            use the build as it is (skip tools/setup.sh; tests use this)
 USAGE
 }
 
 PLANT=sim MODE="" SCENARIO=paper CONFIG="$ROOT/config/platform.yaml" VARIANT="" DURATION=""
-LOG="" DO_LOG=1 DO_REPORT=1 SPY=0 URL="" OUT="" EMULATOR=0
+LOG="" DO_LOG=1 DO_REPORT=1 SPY=0 URL="" OUT="" EMULATOR=0 BUILD_FIRST=1
+ARGS="$*"
 while (($#)); do
   case "$1" in
     --plant) PLANT=$2; shift ;;
@@ -45,6 +47,7 @@ while (($#)); do
     --spy) SPY=1 ;;
     --lcm-url) URL=$2; shift ;;
     --out) OUT=$(realpath -m "$2"); shift ;;
+    --no-build) BUILD_FIRST=0 ;;
     -h|--help) usage; exit 0 ;;
     *) echo "launch: unknown option '$1'" >&2; usage >&2; exit 2 ;;
   esac
@@ -56,7 +59,7 @@ if [[ $PLANT == hw && $MODE == lockstep ]]; then
   echo "launch: the real device cannot step in lockstep; use --realtime" >&2; exit 2
 fi
 
-tools/setup.sh >/dev/null
+((BUILD_FIRST)) && tools/setup.sh >/dev/null
 BUILD=${STEWART_BUILD_DIR:-$ROOT/build}
 bin() { # path of a built program, or fail naming it
   local p
@@ -91,7 +94,7 @@ else cp "$ROOT/config/scenarios/$SCENARIO.yaml" "$OUT/scenario.yaml"; fi
   echo "duration_s: $DURATION"
   echo "variant: ${VARIANT:-from config}"
   echo "lcm_url: $URL"
-  echo "command: tools/launch.sh $*"
+  echo "command: tools/launch.sh $ARGS"
 } > "$OUT/run.yaml"
 
 echo "== Stewart stack: $PLANT, $MODE, scenario '$SCENARIO' ($DURATION s) =="
@@ -143,7 +146,8 @@ if [[ $PLANT == sim ]]; then
   start plant_sim "$PLANT_SIM" "${COMMON[@]}" --mode "$MODE" --duration "$DURATION"
   PLANT_NAME=plant_sim
 else
-  if ((EMULATOR)); then start hw_emulator "$(bin hw_emulator)" --config "$CONFIG"; fi
+  # The emulator publishes its ground truth (evaluation only) on the run's URL.
+  if ((EMULATOR)); then start hw_emulator "$(bin hw_emulator)" "${COMMON[@]}"; fi
   start hw_bridge "$(bin hw_bridge)" "${COMMON[@]}"
   PLANT_NAME=hw_bridge
 fi

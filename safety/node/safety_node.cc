@@ -57,8 +57,14 @@ void SafetyNode::OnState(const lcm::ReceiveBuffer*, const std::string&, const st
   // replayed log behaves as it did live.
   const bool invalid_state =
       (msg->status & state_t::STATUS_VALID) == 0 || (msg->status & state_t::STATUS_DIVERGED) != 0;
+  const bool pending_for_this =
+      has_pending_nominal_ && pending_nominal_.sample_utime == msg->sample_utime;
+  has_pending_nominal_ = has_pending_nominal_ && !pending_for_this &&
+                         pending_nominal_.sample_utime > msg->sample_utime;
   if (invalid_state) {
     PublishFallback(*msg, force_command_t::FLAG_INVALID_INPUT);
+  } else if (pending_for_this) {
+    FilterNominal(*msg, pending_nominal_);
   } else if (msg->utime - newest_nominal_sample_utime_ > stale_age_us_) {
     PublishFallback(*msg, force_command_t::FLAG_STALE_INPUT);
   }
@@ -76,6 +82,15 @@ void SafetyNode::OnNominal(const lcm::ReceiveBuffer*, const std::string&,
   }
   const state_t* state = FindState(msg->sample_utime);
   if (state == nullptr) {
+    if (msg->sample_utime > newest_state_utime_) {
+      // Multicast from two senders is not ordered: on a loaded machine the
+      // controller's answer can overtake the estimate it answers. Held until
+      // that state arrives (OnState), never filtered against another state.
+      pending_nominal_ = *msg;
+      has_pending_nominal_ = true;
+      health_.Count("nominal_before_state");
+      return;
+    }
     health_.Reject("nominal_without_state");
     return;
   }
@@ -84,10 +99,14 @@ void SafetyNode::OnNominal(const lcm::ReceiveBuffer*, const std::string&,
     PublishFallback(*state, force_command_t::FLAG_STALE_INPUT);
     return;
   }
-  const Vector6d f_safe = filter_.Step(FromArray(state->q), FromArray(state->qd),
-                                       FromArray(msg->force_n), &diagnostics_);
+  FilterNominal(*state, *msg);
+}
+
+void SafetyNode::FilterNominal(const state_t& state, const force_command_t& nominal) {
+  const Vector6d f_safe = filter_.Step(FromArray(state.q), FromArray(state.qd),
+                                       FromArray(nominal.force_n), &diagnostics_);
   if (diagnostics_.flags & safety::kFlagInvalidInput) health_.Reject("invalid_nominal");
-  Publish(*state, msg->sample_utime, f_safe, diagnostics_, 0);
+  Publish(state, nominal.sample_utime, f_safe, diagnostics_, 0);
 }
 
 void SafetyNode::PublishFallback(const state_t& state, int32_t reason_flag) {

@@ -29,6 +29,7 @@ class SafetyNode {
   void Publish(const state_t& state, int64_t sample_utime, const Vector6d& force_n,
                const safety::SafetyDiagnostics& diagnostics, int32_t extra_flags);
   void PublishFallback(const state_t& state, int32_t reason_flag);
+  void FilterNominal(const state_t& state, const force_command_t& nominal);
 
   const StackConfig& config_;
   lcm::LCM* lcm_;
@@ -45,6 +46,9 @@ class SafetyNode {
   int64_t newest_state_utime_ = -1;
   int64_t newest_nominal_sample_utime_ = -1;
   int64_t last_published_sample_utime_ = -1;
+  // A nominal command that arrived before its state (see OnNominal).
+  force_command_t pending_nominal_{};
+  bool has_pending_nominal_ = false;
 
   int64_t seq_ = 0;
   force_command_t command_{};

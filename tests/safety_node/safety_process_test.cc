@@ -95,15 +95,22 @@ TEST(SafetyProcess, FiltersNominalAndFallsBackWhenControllerStops) {
       InverseDynamics(EvaluateDynamics(config.platform, q, Vector6d::Zero()), Vector6d::Zero());
   // The first pair only shows the controller is alive: its state came before
   // any nominal command existed, so it was answered by the fallback already.
+  // Every other pair arrives reordered, nominal first (multicast from two
+  // senders is not ordered): it must wait for its state, not be dropped.
   for (int k = 0; k < 11; ++k) {
     utime += 1000;
     const state_t s = MakeState(utime, q);
-    lcm->publish(config.lcm.channels.state_estimate, &s);
     force_command_t nominal{};
     nominal.utime = nominal.sample_utime = utime;
     nominal.seq = k;
     ToArray(f_hold, nominal.force_n);
-    lcm->publish(config.lcm.channels.command_nominal, &nominal);
+    if (k % 2 == 0) {
+      lcm->publish(config.lcm.channels.state_estimate, &s);
+      lcm->publish(config.lcm.channels.command_nominal, &nominal);
+    } else {
+      lcm->publish(config.lcm.channels.command_nominal, &nominal);
+      lcm->publish(config.lcm.channels.state_estimate, &s);
+    }
     const std::size_t before = sink.received.size();
     if (k == 0) {
       lcm->handleTimeout(200);
