@@ -94,7 +94,7 @@ int RunLauncher(const StackCase& c, const std::string& run_dir, const std::strin
   const std::string command =
       "cd " + ShellQuote(STEWART_SOURCE_DIR) +
       " && STEWART_BUILD_DIR=" + ShellQuote(STEWART_BUILD_DIR) + " flock " +
-      ShellQuote(std::string(STEWART_BUILD_DIR) + "/stack_lockstep_test.lock") + " timeout -k 30 " +
+      ShellQuote(std::string(STEWART_BUILD_DIR) + "/stack_launch.lock") + " timeout -k 30 " +
       std::to_string(kLaunchTimeoutS) + " tools/launch.sh --scenario " + ShellQuote(c.scenario) +
       " --duration " + Format(c.duration_s) + " --no-build --no-report --out " +
       ShellQuote(run_dir) + " --lcm-url " + ShellQuote(url) + " >" + ShellQuote(output_path) +

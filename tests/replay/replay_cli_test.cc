@@ -1,0 +1,315 @@
+// stewart_replay on inputs made here: bad input exits 2 with a message that
+// names the problem; a synthetic run whose safe commands were computed with
+// the filter library replays bit-identically (fallbacks counted apart), and
+// a one-ulp change of one recorded command makes --expect-identical exit 1;
+// messages the logger lost are found and left out; the controller's clock
+// is recovered when the log lacks its first commands.
+#include <gtest/gtest.h>
+#include <stdlib.h>
+#include <sys/wait.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <lcm/lcm-cpp.hpp>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "stewart/config/stack_config.h"
+#include "stewart/controller/controller.h"
+#include "stewart/force_command_t.hpp"
+#include "stewart/safety/diagnostics_lcm.h"
+#include "stewart/safety/safety_filter.h"
+#include "stewart/state_t.hpp"
+
+namespace stewart {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct CommandResult {
+  int exit_code = -1;
+  std::string output;  // stdout and stderr
+};
+
+CommandResult RunReplay(const std::string& args) {
+  CommandResult r;
+  const std::string command = std::string(STEWART_REPLAY_PATH) + " " + args + " 2>&1";
+  FILE* pipe = popen(command.c_str(), "r");
+  if (pipe == nullptr) return r;
+  char buffer[4096];
+  while (size_t n = std::fread(buffer, 1, sizeof buffer, pipe)) r.output.append(buffer, n);
+  const int status = pclose(pipe);
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+nlohmann::json ReadJson(const std::string& path) {
+  std::ifstream in(path);
+  return nlohmann::json::parse(in);
+}
+
+template <typename Msg>
+void Append(lcm::LogFile* log, const std::string& channel, const Msg& msg, int64_t timestamp) {
+  std::vector<uint8_t> buffer(static_cast<size_t>(msg.getEncodedSize()));
+  msg.encode(buffer.data(), 0, static_cast<int>(buffer.size()));
+  lcm::LogEvent event{};
+  event.timestamp = timestamp;
+  event.channel = channel;
+  event.datalen = static_cast<int32_t>(buffer.size());
+  event.data = buffer.data();
+  ASSERT_EQ(log->writeEvent(&event), 0);
+}
+
+constexpr int kSamples = 200;
+constexpr int kInitializing = 5;   // first samples: estimator initialising -> node fallback
+constexpr int kStaleSample = 100;  // answered by the watchdog's fallback before its nominal
+
+class ReplayCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    char dir[] = "/tmp/stewart_replay_cli_XXXXXX";
+    ASSERT_NE(mkdtemp(dir), nullptr) << std::strerror(errno);
+    root_ = dir;
+  }
+  void TearDown() override {
+    if (HasFailure()) {
+      std::printf("kept: %s\n", root_.c_str());
+      return;
+    }
+    std::error_code ignored;
+    fs::remove_all(root_, ignored);
+  }
+
+  /// A run folder as launch.sh makes it, with a log written here: the safe
+  /// commands as the safety node computes them (closed form). With
+  /// `tamper_sample` >= 0 that sample's recorded force 0 is one ulp off;
+  /// samples [drop_from, drop_from + drop_count) are left out of the log, as
+  /// lcm-logger loses a burst.
+  std::string MakeRun(const std::string& name, int tamper_sample = -1, int drop_from = -1,
+                      int drop_count = 0) {
+    const std::string run = root_ + "/" + name;
+    fs::create_directories(run);
+    const std::string config_path = std::string(STEWART_SOURCE_DIR) + "/config/platform.yaml";
+    fs::copy_file(config_path, run + "/config.yaml");
+    std::ofstream(run + "/run.yaml") << "variant: closed_form\n";
+    StackConfig config = LoadStackConfig(config_path);
+    config.safety.variant = SafetyVariant::kClosedForm;
+    safety::SafetyFilter filter(config.platform, config.safety, config.actuators);
+    const ChannelNames& ch = config.lcm.channels;
+
+    lcm::LogFile log(run + "/log.lcm", "w");
+    EXPECT_TRUE(log.good());
+    safety::SafetyDiagnostics d;
+    safety_diagnostics_t diag{};
+    int64_t timestamp = 1'000'000;
+    int64_t nominal_seq = 0;
+    for (int k = 0; k < kSamples; ++k) {
+      const bool dropped = k >= drop_from && k < drop_from + drop_count;
+      const int64_t utime = 1000 * (k + 1);
+      const double t = 1e-3 * k;
+      state_t state{};
+      state.utime = state.sample_utime = utime;
+      state.seq = k;
+      const double q[6] = {0.1 + 0.02 * t, 0.05 * std::sin(t), 0.45, 0.01, -0.02, 0.0};
+      const double qd[6] = {0.0145, 0.01 * std::cos(t), 0.009, 0.0, 0.05, -0.01};
+      std::copy(q, q + 6, state.q);
+      std::copy(qd, qd + 6, state.qd);
+      state.status = k < kInitializing ? int32_t{state_t::STATUS_INITIALIZING}
+                                       : int32_t{state_t::STATUS_VALID};
+      if (!dropped) Append(&log, ch.state_estimate, state, timestamp++);
+
+      force_command_t nominal{};
+      nominal.utime = nominal.sample_utime = utime;
+      if (k >= kInitializing) nominal.seq = nominal_seq++;
+      for (int i = 0; i < 6; ++i) nominal.force_n[i] = 1.5 + 0.3 * std::sin(t + i);
+      force_command_t safe{};
+      safe.utime = safe.sample_utime = utime;
+      safe.seq = k;
+      Vector6d f;
+      if (k < kInitializing || k == kStaleSample) {
+        f = filter.SafeStopCommand(FromArrayOf(state.q), FromArrayOf(state.qd), &d);
+        safe.flags = d.flags | (k < kInitializing ? int32_t{force_command_t::FLAG_INVALID_INPUT}
+                                                  : int32_t{force_command_t::FLAG_STALE_INPUT});
+      } else {
+        f = filter.Step(FromArrayOf(state.q), FromArrayOf(state.qd), FromArrayOf(nominal.force_n),
+                        &d);
+        safe.flags = d.flags;
+      }
+      for (int i = 0; i < 6; ++i) safe.force_n[i] = f(i);
+      if (k == tamper_sample) safe.force_n[0] = std::nextafter(safe.force_n[0], 1e9);
+      safety::FillDiagnosticsMessage(filter, d, &diag);
+      diag.utime = diag.sample_utime = utime;
+      diag.seq = k;
+      if (dropped) continue;
+      if (k == kStaleSample) Append(&log, ch.command_safe, safe, timestamp++);
+      if (k >= kInitializing) Append(&log, ch.command_nominal, nominal, timestamp++);
+      if (k != kStaleSample) Append(&log, ch.command_safe, safe, timestamp++);
+      Append(&log, ch.safety_diagnostics, diag, timestamp++);
+    }
+    return run;
+  }
+
+  static Vector6d FromArrayOf(const double (&a)[6]) { return Eigen::Map<const Vector6d>(a); }
+
+  std::string root_;
+};
+
+// A log whose first messages the logger lost: the controller's commands
+// (computed here on a scenario that changes from t = 0) still replay
+// bit-identically from the inferred start of its clock.
+TEST_F(ReplayCli, ControllerClockRecoveredWhenTheLogLacksTheStart) {
+  constexpr int kStates = 300;
+  constexpr int kLost = 40;  // the log lacks the first kLost estimates and commands
+  const std::string run = root_ + "/run";
+  fs::create_directories(run);
+  const std::string config_path = std::string(STEWART_SOURCE_DIR) + "/config/platform.yaml";
+  fs::copy_file(config_path, run + "/config.yaml");
+  std::ofstream(run + "/scenario.yaml")
+      << "name: wave\nduration_s: 1.0\nsegments:\n"
+      << "  - {start_s: 0.0, type: sine, center: [0.0, 0.0, 0.4, 0.0, 0.0, 0.0], "
+      << "amplitude: [0.02, 0.01, 0.0, 0.0, 0.0, 0.0], period_s: 0.2, "
+      << "phase_deg: [0.0, 90.0, 0.0, 0.0, 0.0, 0.0]}\n";
+  const StackConfig config = LoadStackConfig(config_path);
+  Controller controller(config.platform, config.controller, config.home_pose,
+                        LoadScenario(run + "/scenario.yaml"));
+  {
+    lcm::LogFile log(run + "/log.lcm", "w");
+    ASSERT_TRUE(log.good());
+    for (int k = 0; k < kStates; ++k) {
+      state_t state{};
+      state.utime = state.sample_utime = 1000 * (k + 1);
+      state.seq = k;
+      state.q[2] = 0.4 + 1e-3 * std::sin(0.05 * k);
+      state.qd[0] = 0.01 * std::cos(0.05 * k);
+      state.status = state_t::STATUS_VALID;
+      ControllerOutput out;
+      ASSERT_EQ(controller.Step(state.utime, FromArrayOf(state.q), FromArrayOf(state.qd), &out),
+                StepStatus::kOk);
+      force_command_t nominal{};
+      nominal.utime = nominal.sample_utime = state.sample_utime;
+      nominal.seq = k;
+      for (int i = 0; i < 6; ++i) nominal.force_n[i] = out.force_n(i);
+      if (k < kLost) continue;
+      Append(&log, config.lcm.channels.state_estimate, state, 1000 + k);
+      Append(&log, config.lcm.channels.command_nominal, nominal, 1000 + k);
+    }
+  }
+  const std::string json_path = root_ + "/replay.json";
+  const CommandResult r = RunReplay(run + " --controller --expect-identical --json " + json_path);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const nlohmann::json c = ReadJson(json_path).at("controller");
+  EXPECT_TRUE(c.at("time_origin_inferred").get<bool>());
+  EXPECT_EQ(c.at("time_origin_utime"), 1000);
+  EXPECT_EQ(c.at("compared"), kStates - kLost);
+  EXPECT_EQ(c.at("identical"), kStates - kLost);
+  EXPECT_NE(r.output.find("inferred"), std::string::npos) << r.output;
+}
+
+TEST_F(ReplayCli, MissingRunFolderExitsTwo) {
+  const CommandResult r = RunReplay(root_ + "/no-such-run");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("no run folder or LCM log"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find(root_ + "/no-such-run"), std::string::npos) << r.output;
+}
+
+TEST_F(ReplayCli, MissingLogExitsTwo) {
+  const std::string run = MakeRun("run");
+  fs::remove(run + "/log.lcm");
+  const CommandResult r = RunReplay(run + " --json " + root_ + "/out.json");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("no LCM log '" + run + "/log.lcm'"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(root_ + "/out.json"));
+}
+
+TEST_F(ReplayCli, UnreadableLogExitsTwo) {
+  const std::string run = MakeRun("run");
+  std::ofstream(run + "/log.lcm", std::ios::trunc) << "this is not an LCM log\n";
+  const CommandResult r = RunReplay(run);
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("holds no LCM event"), std::string::npos) << r.output;
+}
+
+TEST_F(ReplayCli, BadFlagsExitTwo) {
+  const std::string run = MakeRun("run");
+  for (const char* args : {" --variant fastest", " --k-velocity -3", " --qp-solver mosek",
+                           " --no-such-flag", " --controller --scenario /no/such.yaml"}) {
+    const CommandResult r = RunReplay(run + args);
+    EXPECT_EQ(r.exit_code, 2) << args << ": " << r.output;
+  }
+}
+
+TEST_F(ReplayCli, SyntheticRunReplaysBitIdentically) {
+  const std::string run = MakeRun("run");
+  const std::string json_path = root_ + "/replay.json";
+  const CommandResult r = RunReplay(run + " --expect-identical --json " + json_path);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const nlohmann::json j = ReadJson(json_path);
+  const nlohmann::json& s = j.at("safety");
+  EXPECT_EQ(s.at("variant"), "closed_form");
+  EXPECT_EQ(s.at("variant_source"), "run.yaml");
+  EXPECT_EQ(s.at("nominal_commands"), kSamples - kInitializing);
+  EXPECT_EQ(s.at("answered_by_fallback"), 1);
+  EXPECT_EQ(s.at("compared"), kSamples - kInitializing - 1);
+  EXPECT_EQ(s.at("identical"), s.at("compared"));
+  EXPECT_EQ(s.at("max_abs_diff_n"), 0.0);
+  EXPECT_EQ(s.at("fallback").at("recorded"), kInitializing + 1);
+  EXPECT_EQ(s.at("fallback").at("stale_input"), 1);
+  EXPECT_EQ(s.at("fallback").at("invalid_state"), kInitializing);
+  EXPECT_EQ(s.at("fallback").at("identical"), kInitializing + 1);
+  EXPECT_EQ(s.at("compute_ns").at("replayed").at("count"), s.at("compared"));
+  EXPECT_EQ(s.at("compute_ns").at("recorded").at("count"), s.at("compared"));
+  EXPECT_TRUE(j.at("identical").get<bool>());
+  EXPECT_TRUE(j.at("log_gaps").empty());
+  EXPECT_NE(r.output.find("bit-identical"), std::string::npos) << r.output;
+}
+
+TEST_F(ReplayCli, MessagesLostByTheLoggerAreFoundAndNotCompared) {
+  constexpr int kDropFrom = 120, kDropCount = 7;
+  const std::string run = MakeRun("run", -1, kDropFrom, kDropCount);
+  const std::string json_path = root_ + "/replay.json";
+  const CommandResult r = RunReplay(run + " --expect-identical --json " + json_path);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const nlohmann::json j = ReadJson(json_path);
+  const StackConfig config = LoadStackConfig(run + "/config.yaml");
+  for (const std::string& channel :
+       {config.lcm.channels.state_estimate, config.lcm.channels.command_nominal,
+        config.lcm.channels.command_safe, config.lcm.channels.safety_diagnostics}) {
+    ASSERT_TRUE(j.at("log_gaps").contains(channel)) << channel << ": " << j.at("log_gaps");
+    const nlohmann::json& gaps = j.at("log_gaps").at(channel);
+    EXPECT_EQ(gaps.at("missing"), kDropCount) << channel;
+    EXPECT_EQ(gaps.at("gaps"), 1) << channel;
+    EXPECT_EQ(gaps.at("intact_until_utime"), 1000 * kDropFrom) << channel;
+  }
+  const nlohmann::json& s = j.at("safety");
+  EXPECT_EQ(s.at("compared"), kSamples - kInitializing - 1 - kDropCount);
+  EXPECT_EQ(s.at("identical"), s.at("compared"));
+  EXPECT_NE(r.output.find("log gap " + config.lcm.channels.command_safe +
+                          ": 7 messages published but not in the log"),
+            std::string::npos)
+      << r.output;
+}
+
+TEST_F(ReplayCli, OneUlpDifferenceFailsExpectIdentical) {
+  constexpr int kTampered = 150;
+  const std::string run = MakeRun("run", kTampered);
+  const std::string json_path = root_ + "/replay.json";
+  const CommandResult r = RunReplay(run + " --expect-identical --json " + json_path);
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  const nlohmann::json j = ReadJson(json_path);
+  const nlohmann::json& s = j.at("safety");
+  EXPECT_EQ(s.at("identical").get<long>(), s.at("compared").get<long>() - 1);
+  EXPECT_GT(s.at("max_abs_diff_n").get<double>(), 0.0);
+  EXPECT_LT(s.at("max_abs_diff_n").get<double>(), 1e-12);
+  EXPECT_EQ(s.at("worst_sample_utime"), 1000 * (kTampered + 1));
+  EXPECT_EQ(j.at("differing"), 1);
+  // Without --expect-identical the same difference is only reported.
+  EXPECT_EQ(RunReplay(run).exit_code, 0);
+}
+
+}  // namespace
+}  // namespace stewart

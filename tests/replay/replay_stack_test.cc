@@ -1,0 +1,282 @@
+// stewart_replay on a real run: tools/launch.sh runs the LCM stack (plant_sim
+// in lockstep, estimator, controller, safety, lcm-logger) on the paper
+// scenario for 4 s on a private URL and writes the report; then, on the
+// recorded inputs:
+//   - the closed-form replay of the safety filter is bit-identical to every
+//     recorded non-fallback safe command (>= 3500 of them), fallbacks too;
+//   - the QP reference differs from the closed form by < 1e-6 N everywhere;
+//   - the controller replay is bit-identical to the recorded nominal commands;
+//   - the estimator replay is bit-identical to the recorded estimates, up to
+//     the first input lcm-logger lost if it lost any (see below).
+// The report has its "Closed form vs QP reference" section.
+//
+// On a failure the temporary run folder is kept and its path printed.
+#include <gtest/gtest.h>
+#include <stdlib.h>
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "stewart/config/stack_config.h"
+
+namespace stewart {
+namespace {
+
+constexpr int kLcmPort = 7830;  // this folder's ports: 7830-7839
+constexpr double kDurationS = 4.0;
+constexpr int kLaunchTimeoutS = 300;
+constexpr long kMinCompared = 3500;
+constexpr int kAttempts = 3;            // stack runs until lcm-logger records every message
+constexpr double kQpToleranceN = 1e-6;  // the acceptance bound
+std::string ShellQuote(const std::string& s) {
+  std::string quoted = "'";
+  for (char ch : s) {
+    if (ch == '\'') {
+      quoted += "'\\''";
+    } else {
+      quoted += ch;
+    }
+  }
+  return quoted + "'";
+}
+
+std::string ReadFile(const std::string& path) {
+  std::ifstream in(path);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+/// Exit code of a shell command (128 + signal if killed, -1 if it could not run).
+int Shell(const std::string& command) {
+  const int status = std::system(command.c_str());
+  if (status == -1) return -1;
+  if (WIFEXITED(status)) return WEXITSTATUS(status);
+  return WIFSIGNALED(status) ? 128 + WTERMSIG(status) : -1;
+}
+
+/// Messages of `channel` lcm-logger lost (seq gaps), from stewart_replay's JSON.
+long Missing(const nlohmann::json& replay, const std::string& channel) {
+  const nlohmann::json& gaps = replay.at("log_gaps");
+  return gaps.contains(channel) ? gaps.at(channel).at("missing").get<long>() : 0;
+}
+
+/// sample_utime -> replayed force of one --csv file of stewart_replay.
+std::map<long long, std::vector<double>> ReadReplayedForces(const std::string& path) {
+  std::map<long long, std::vector<double>> forces;
+  std::ifstream in(path);
+  std::string line;
+  std::getline(in, line);
+  std::vector<std::string> header;
+  {
+    std::stringstream cells(line);
+    for (std::string cell; std::getline(cells, cell, ',');) header.push_back(cell);
+  }
+  const auto column = [&header](const std::string& name) {
+    return static_cast<size_t>(std::find(header.begin(), header.end(), name) - header.begin());
+  };
+  const size_t sample_column = column("sample_utime_us");
+  const size_t force_column = column("f_replayed0_n");
+  while (std::getline(in, line)) {
+    std::vector<std::string> cells;
+    std::stringstream row(line);
+    for (std::string cell; std::getline(row, cell, ',');) cells.push_back(cell);
+    if (cells.size() != header.size()) continue;
+    std::vector<double>& f = forces[std::stoll(cells[sample_column])];
+    for (size_t i = 0; i < 6; ++i) f.push_back(std::stod(cells[force_column + i]));
+  }
+  return forces;
+}
+
+class ReplayStack : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    char dir[] = "/tmp/stewart_replay_stack_XXXXXX";
+    ASSERT_NE(mkdtemp(dir), nullptr) << std::strerror(errno);
+    root_ = dir;
+  }
+  void TearDown() override {
+    if (HasFailure()) {
+      std::printf("run folder kept: %s\n", root_.c_str());
+      return;
+    }
+    std::error_code ignored;
+    std::filesystem::remove_all(root_, ignored);
+  }
+
+  /// stewart_replay on the run; its stdout and stderr go to <root>/<name>.out.
+  int Replay(const std::string& run, const std::string& args, const std::string& name) {
+    return Shell(ShellQuote(STEWART_REPLAY_PATH) + " " + ShellQuote(run) + " " + args + " >" +
+                 ShellQuote(root_ + "/" + name + ".out") + " 2>&1");
+  }
+
+  std::string root_;
+};
+
+/// Messages of all channels lcm-logger lost.
+long TotalMissing(const nlohmann::json& replay) {
+  long missing = 0;
+  for (const auto& gaps : replay.at("log_gaps")) missing += gaps.at("missing").get<long>();
+  return missing;
+}
+
+TEST_F(ReplayStack, LockstepRunReplaysBitIdentically) {
+  const std::string url = "udpm://239.255.76.67:" + std::to_string(kLcmPort) + "?ttl=0";
+  char duration[16];
+  std::snprintf(duration, sizeof duration, "%g", kDurationS);
+  const std::string cf_json = root_ + "/closed_form.json";
+  const std::string cf_csv = root_ + "/closed_form.csv";
+  // lcm-logger drops bursts silently when it is descheduled (see the
+  // estimator below); the live stack does not. A log with gaps still replays
+  // exactly where it has the messages, but lacks some of them: the stack is
+  // run again (up to kAttempts times) for a complete log, and the counts
+  // below allow for what the last attempt's log lacks.
+  std::string run;
+  nlohmann::json cf;
+  for (int attempt = 1; attempt <= kAttempts; ++attempt) {
+    run = root_ + "/run" + std::to_string(attempt);
+    const std::string launch_out = root_ + "/launch" + std::to_string(attempt) + ".out";
+    const int launch = Shell("cd " + ShellQuote(STEWART_SOURCE_DIR) +
+                             " && STEWART_BUILD_DIR=" + ShellQuote(STEWART_BUILD_DIR) + " flock " +
+                             ShellQuote(std::string(STEWART_BUILD_DIR) + "/stack_launch.lock") +
+                             " timeout -k 30 " + std::to_string(kLaunchTimeoutS) +
+                             " tools/launch.sh --no-build --scenario paper --duration " + duration +
+                             " --out " + ShellQuote(run) + " --lcm-url " + ShellQuote(url) + " >" +
+                             ShellQuote(launch_out) + " 2>&1");
+    ASSERT_EQ(launch, 0) << "tools/launch.sh failed (124: killed by the " << kLaunchTimeoutS
+                         << " s guard); its output:\n"
+                         << ReadFile(launch_out);
+
+    // The safety filter, the controller and the estimator as they ran.
+    ASSERT_EQ(Replay(run,
+                     "--variant closed_form --controller --estimator --expect-identical --json " +
+                         ShellQuote(cf_json) + " --csv " + ShellQuote(cf_csv),
+                     "closed_form"),
+              0)
+        << ReadFile(root_ + "/closed_form.out");
+    cf = nlohmann::json::parse(ReadFile(cf_json));
+    if (TotalMissing(cf) == 0) break;
+    std::printf("[replay] attempt %d: lcm-logger lost %ld messages: %s\n", attempt,
+                TotalMissing(cf), cf["log_gaps"].dump().c_str());
+  }
+  std::printf("%s", ReadFile(root_ + "/closed_form.out").c_str());
+  const ChannelNames channels = LoadStackConfig(run + "/config.yaml").lcm.channels;
+  const long missing_estimates = Missing(cf, channels.state_estimate);
+  // Nominal commands (or their safe commands) the log lacks cannot be compared.
+  const long missing_commands =
+      Missing(cf, channels.command_nominal) + Missing(cf, channels.command_safe);
+
+  const nlohmann::json& s = cf.at("safety");
+  EXPECT_EQ(s.at("recorded_variant"), "closed_form");
+  EXPECT_GE(s.at("compared").get<long>() + missing_commands, kMinCompared);
+  EXPECT_EQ(s.at("identical"), s.at("compared")) << "max |dF| " << s.at("max_abs_diff_n");
+  EXPECT_EQ(s.at("max_abs_diff_n").get<double>(), 0.0);
+  EXPECT_EQ(s.at("flags_differ"), 0);
+  EXPECT_LE(s.at("without_state").get<long>(), missing_estimates);
+  // The live node's fallbacks (estimator initialising, watchdog) are counted
+  // apart and reproduced by the replayed safe stop.
+  EXPECT_EQ(s.at("fallback").at("identical"), s.at("fallback").at("compared"));
+  EXPECT_LE(s.at("fallback").at("without_input").get<long>(), missing_estimates);
+
+  const nlohmann::json& c = cf.at("controller");
+  EXPECT_GE(c.at("compared").get<long>() + missing_commands, kMinCompared);
+  EXPECT_EQ(c.at("identical"), c.at("compared")) << "max |dF| " << c.at("max_abs_diff_n");
+  EXPECT_LE(c.at("recorded_without_replay").get<long>(), missing_estimates);
+
+  // The estimator is a deterministic function of its inputs in the order it
+  // received them, and in lockstep the logger receives sensors and safe
+  // commands in that same order (the plant sends sample k+1 only after safe
+  // command k reached it, so command k is queued at every subscriber before
+  // sample k+1 is sent; LCM delivers one socket's messages in order). So the
+  // replay in log order is bit-identical as long as the log holds every
+  // input, and that is asserted. But lcm-logger subscribes with LCM 1.3.1's
+  // default 30-message queue and drops bursts silently when it is descheduled
+  // (seen in most runs on a loaded 2-core machine: 1 to 340 messages per
+  // channel in 4 s, often in the first 20 ms); the live estimator had those
+  // inputs, the replay does not. The estimates after the first lost input
+  // (stewart_replay finds it from the seq gaps) are reported apart and no
+  // tight bound holds for them: it depends on what was lost (a burst longer
+  // than estimator.max_dt_s even re-initialises the replayed EKF). Measured:
+  // 7e-6 m / 9e-5 m/s after a 15 ms burst at 18 s, up to 6e-5 m / 3e-3 m/s
+  // (8 sigma) after bursts during the EKF's start, 1.1 mm / 0.06 m/s after a
+  // run that lost 11 % of its messages. So they are printed, not bounded; the
+  // stack is re-run above for a complete log, on which all estimates compare.
+  const nlohmann::json& e = cf.at("estimator");
+  const nlohmann::json& after = e.at("after_gap");
+  const long missing_inputs = e.at("inputs_missing").get<long>();
+  std::printf(
+      "[replay] estimator: %ld compared, %ld identical, max |dq| %g, max |dqd| %g; %ld inputs "
+      "missing from the log, %ld estimates after the gap (max |dq| %g, max |dqd| %g, max %g "
+      "sigma)\n",
+      e.at("compared").get<long>(), e.at("identical").get<long>(),
+      e.at("max_abs_diff_q").get<double>(), e.at("max_abs_diff_qd").get<double>(), missing_inputs,
+      after.at("compared").get<long>(), after.at("max_abs_diff_q").get<double>(),
+      after.at("max_abs_diff_qd").get<double>(), after.at("max_diff_sigma").get<double>());
+  EXPECT_EQ(missing_inputs, Missing(cf, channels.sensors) + Missing(cf, channels.command_safe));
+  EXPECT_GE(e.at("compared").get<long>() + after.at("compared").get<long>() + missing_estimates +
+                missing_inputs,
+            static_cast<long>(0.95 * kDurationS * 1000));
+  EXPECT_GT(e.at("compared").get<long>(), 0);
+  EXPECT_EQ(e.at("identical"), e.at("compared"));
+  EXPECT_EQ(e.at("max_abs_diff_q").get<double>(), 0.0);
+  EXPECT_EQ(e.at("max_abs_diff_qd").get<double>(), 0.0);
+  EXPECT_EQ(e.at("status_differ"), 0);
+  if (missing_inputs == 0) {
+    EXPECT_EQ(after.at("compared"), 0);
+  }
+  // A recorded estimate whose sensor sample the logger lost cannot be replayed.
+  EXPECT_LE(e.at("recorded_without_replay").get<long>(), missing_inputs);
+
+  // The QP reference on the same inputs: the same forces within 1e-6 N.
+  const std::string qp_json = root_ + "/qp.json";
+  const std::string qp_csv = root_ + "/qp.csv";
+  const int qp_exit = Replay(run,
+                             "--variant qp --expect-identical --json " + ShellQuote(qp_json) +
+                                 " --csv " + ShellQuote(qp_csv),
+                             "qp");
+  ASSERT_TRUE(qp_exit == 0 || qp_exit == 1) << ReadFile(root_ + "/qp.out");
+  const nlohmann::json qp = nlohmann::json::parse(ReadFile(qp_json));
+  EXPECT_EQ(qp_exit, qp.at("differing").get<long>() > 0 ? 1 : 0);
+  EXPECT_EQ(qp.at("safety").at("variant"), "qp");
+  const auto cf_forces = ReadReplayedForces(cf_csv);
+  const auto qp_forces = ReadReplayedForces(qp_csv);
+  ASSERT_EQ(cf_forces.size(), qp_forces.size());
+  ASSERT_GE(static_cast<long>(cf_forces.size()) + missing_commands, kMinCompared);
+  double max_diff = 0.0;
+  long long worst = -1;
+  for (const auto& [sample, f_cf] : cf_forces) {
+    const auto it = qp_forces.find(sample);
+    ASSERT_NE(it, qp_forces.end()) << "sample " << sample;
+    for (size_t i = 0; i < 6; ++i) {
+      const double d = std::fabs(f_cf[i] - it->second[i]);
+      if (d > max_diff) {
+        max_diff = d;
+        worst = sample;
+      }
+    }
+  }
+  std::printf("[replay] max |F_closed_form - F_qp| = %.3g N over %zu steps (at %lld)\n", max_diff,
+              cf_forces.size(), worst);
+  EXPECT_LT(max_diff, kQpToleranceN) << "at sample_utime " << worst;
+  EXPECT_LT(qp.at("safety").at("max_abs_diff_n").get<double>(), kQpToleranceN);
+
+  // The launcher's report compares the two.
+  const std::string report = ReadFile(run + "/report.md");
+  EXPECT_NE(report.find("## Closed form vs QP reference"), std::string::npos) << report;
+  EXPECT_NE(report.find("reproduces the recorded commands: yes, bit-identical"), std::string::npos)
+      << report;
+}
+
+}  // namespace
+}  // namespace stewart

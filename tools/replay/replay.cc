@@ -1,0 +1,533 @@
+#include "replay.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <lcm/lcm-cpp.hpp>
+#include <optional>
+#include <unordered_map>
+#include <unordered_set>
+
+#include "sensor_msg.h"
+#include "stewart/controller/controller.h"
+#include "stewart/estimator/ekf.h"
+#include "stewart/node/eigen_msg.h"
+#include "stewart/safety/safety_filter.h"
+#include "stewart/safety_diagnostics_t.hpp"
+
+namespace stewart::replay {
+namespace {
+
+template <typename Msg>
+bool Decode(const lcm::LogEvent& event, Msg* msg) {
+  return msg->decode(event.data, 0, event.datalen) == event.datalen;
+}
+
+/// sample_utime -> index of the first message with it.
+template <typename Msg>
+std::unordered_map<int64_t, int> IndexBySample(const std::vector<Msg>& messages) {
+  std::unordered_map<int64_t, int> index;
+  index.reserve(messages.size());
+  for (size_t i = 0; i < messages.size(); ++i) {
+    index.emplace(messages[i].sample_utime, static_cast<int>(i));
+  }
+  return index;
+}
+
+template <typename Map>
+const typename Map::mapped_type* Find(const Map& map, int64_t key) {
+  const auto it = map.find(key);
+  return it == map.end() ? nullptr : &it->second;
+}
+
+bool IsFallback(int32_t flags) {
+  return (flags & (force_command_t::FLAG_FALLBACK | force_command_t::FLAG_STALE_INPUT)) != 0;
+}
+
+// As the safety node and the controller judge a state estimate.
+bool StateUsable(const state_t& s) {
+  return (s.status & state_t::STATUS_VALID) != 0 && (s.status & state_t::STATUS_DIVERGED) == 0;
+}
+
+SafetyVariant FromLcmVariant(int8_t v) {
+  switch (v) {
+    case safety_diagnostics_t::VARIANT_PAPER_RULE:
+      return SafetyVariant::kPaperRule;
+    case safety_diagnostics_t::VARIANT_QP_REFERENCE:
+      return SafetyVariant::kQpReference;
+    default:
+      return SafetyVariant::kClosedForm;
+  }
+}
+
+std::array<double, 6> ToStdArray(const Vector6d& v) {
+  std::array<double, 6> a{};
+  for (int i = 0; i < 6; ++i) a[static_cast<size_t>(i)] = v(i);
+  return a;
+}
+
+}  // namespace
+
+RecordedLog ReadLog(const std::string& path, const ChannelNames& channels) {
+  lcm::LogFile file(path, "r");
+  if (!file.good()) throw InputError("cannot open the LCM log '" + path + "'");
+  const std::unordered_map<std::string, Channel> routes = {
+      {channels.sensors, Channel::kSensors},
+      {channels.state_estimate, Channel::kStateEstimate},
+      {channels.state_truth, Channel::kStateTruth},
+      {channels.command_nominal, Channel::kCommandNominal},
+      {channels.command_safe, Channel::kCommandSafe},
+      {channels.safety_diagnostics, Channel::kSafetyDiagnostics},
+  };
+  RecordedLog log;
+  for (const auto& [name, channel] : routes) log.channel_names[static_cast<size_t>(channel)] = name;
+  std::array<std::optional<std::pair<int64_t, int64_t>>, kNumChannels> last;  // seq, utime
+  auto track = [&log, &last](Channel channel, int64_t seq, int64_t utime) {
+    const auto c = static_cast<size_t>(channel);
+    SeqGaps& gaps = log.gaps[c];
+    // Every publisher starts at seq 0: a first seq > 0 means the log lacks
+    // the channel's first messages. A seq that does not increase is a
+    // restarted publisher, not a gap.
+    const int64_t expected = last[c] ? last[c]->first + 1 : 0;
+    if (seq > expected) {
+      if (gaps.gaps == 0) gaps.intact_until_utime = last[c] ? last[c]->second : utime - 1;
+      ++gaps.gaps;
+      gaps.missing += seq - expected;
+    }
+    last[c] = std::make_pair(seq, utime);
+    if (log.first_utime < 0 || utime < log.first_utime) log.first_utime = utime;
+    log.last_utime = std::max(log.last_utime, utime);
+  };
+  safety_diagnostics_t diagnostics;  // reused: keeps its string and array capacities
+  while (const lcm::LogEvent* event = file.readNextEvent()) {
+    if (log.events == 0) log.first_timestamp_us = event->timestamp;
+    log.last_timestamp_us = event->timestamp;
+    ++log.events;
+    const auto route = routes.find(event->channel);
+    if (route == routes.end()) continue;
+    bool ok = false;
+    int index = 0;
+    switch (route->second) {
+      case Channel::kSensors:
+        index = static_cast<int>(log.sensors.size());
+        ok = Decode(*event, &log.sensors.emplace_back());
+        if (!ok) log.sensors.pop_back();
+        break;
+      case Channel::kStateEstimate:
+        index = static_cast<int>(log.estimates.size());
+        ok = Decode(*event, &log.estimates.emplace_back());
+        if (!ok) log.estimates.pop_back();
+        break;
+      case Channel::kStateTruth:
+        index = static_cast<int>(log.truth.size());
+        ok = Decode(*event, &log.truth.emplace_back());
+        if (!ok) log.truth.pop_back();
+        break;
+      case Channel::kCommandNominal:
+        index = static_cast<int>(log.nominal.size());
+        ok = Decode(*event, &log.nominal.emplace_back());
+        if (!ok) log.nominal.pop_back();
+        break;
+      case Channel::kCommandSafe:
+        index = static_cast<int>(log.safe.size());
+        ok = Decode(*event, &log.safe.emplace_back());
+        if (!ok) log.safe.pop_back();
+        break;
+      case Channel::kSafetyDiagnostics:
+        index = static_cast<int>(log.diagnostics.size());
+        ok = Decode(*event, &diagnostics);
+        if (ok) {
+          log.diagnostics.push_back({diagnostics.sample_utime, diagnostics.compute_ns,
+                                     diagnostics.variant, diagnostics.force_limits != 0});
+        }
+        break;
+    }
+    if (ok) {
+      log.order.emplace_back(route->second, index);
+      const size_t i = static_cast<size_t>(index);
+      switch (route->second) {
+        case Channel::kSensors:
+          track(route->second, log.sensors[i].seq, log.sensors[i].utime);
+          break;
+        case Channel::kStateEstimate:
+          track(route->second, log.estimates[i].seq, log.estimates[i].utime);
+          break;
+        case Channel::kStateTruth:
+          track(route->second, log.truth[i].seq, log.truth[i].utime);
+          break;
+        case Channel::kCommandNominal:
+          track(route->second, log.nominal[i].seq, log.nominal[i].utime);
+          break;
+        case Channel::kCommandSafe:
+          track(route->second, log.safe[i].seq, log.safe[i].utime);
+          break;
+        case Channel::kSafetyDiagnostics:
+          track(route->second, diagnostics.seq, diagnostics.utime);
+          break;
+      }
+    } else {
+      ++log.undecodable[event->channel];
+    }
+  }
+  if (log.events == 0) {
+    throw InputError("'" + path + "' holds no LCM event (empty, or not an LCM log)");
+  }
+  return log;
+}
+
+void DiffStats::Add(int64_t sample_utime, const double* replayed, const double* recorded, int n,
+                    bool other_fields_equal) {
+  ++compared;
+  const size_t bytes = sizeof(double) * static_cast<size_t>(n);
+  if (other_fields_equal && std::memcmp(replayed, recorded, bytes) == 0) ++identical;
+  double diff = 0.0;
+  double scale = 0.0;
+  for (int i = 0; i < n; ++i) {
+    diff = std::fmax(diff, std::fabs(replayed[i] - recorded[i]));
+    scale = std::fmax(scale, std::fabs(recorded[i]));
+  }
+  if (diff > max_abs_diff) {
+    max_abs_diff = diff;
+    worst_sample_utime = sample_utime;
+  }
+  if (diff > 0.0) {
+    max_rel_diff = std::fmax(max_rel_diff, scale > 0.0 ? diff / scale : HUGE_VAL);
+  }
+}
+
+TimeStats ComputeTimeStats(std::vector<int64_t> ns) {
+  TimeStats s;
+  s.count = static_cast<long>(ns.size());
+  if (ns.empty()) return s;
+  std::sort(ns.begin(), ns.end());
+  auto percentile = [&ns](double p) {
+    const double rank = p / 100.0 * static_cast<double>(ns.size() - 1);
+    const size_t lo = static_cast<size_t>(std::floor(rank));
+    const size_t hi = std::min(lo + 1, ns.size() - 1);
+    const double frac = rank - static_cast<double>(lo);
+    return static_cast<double>(ns[lo]) +
+           frac * (static_cast<double>(ns[hi]) - static_cast<double>(ns[lo]));
+  };
+  s.p50_ns = percentile(50.0);
+  s.p99_ns = percentile(99.0);
+  s.max_ns = static_cast<double>(ns.back());
+  return s;
+}
+
+SafetyReplayResult ReplaySafety(const StackConfig& config, const RecordedLog& log,
+                                safety::ReferenceQpSolver* reference) {
+  SafetyReplayResult r;
+  safety::SafetyFilter filter(config.platform, config.safety, config.actuators, reference);
+  r.variant = filter.variant();
+  if (r.variant == SafetyVariant::kQpReference && reference != nullptr) {
+    r.qp_solver = reference->name();
+  }
+  r.force_limits = filter.force_limits();
+  r.k_position = config.safety.k_position;
+  r.k_velocity = config.safety.k_velocity;
+
+  // What the live filter was: the most frequent variant in its diagnostics.
+  if (!log.diagnostics.empty()) {
+    std::map<int8_t, long> variants;
+    long limited = 0;
+    for (const RecordedDiagnostics& d : log.diagnostics) {
+      ++variants[d.variant];
+      limited += d.force_limits ? 1 : 0;
+    }
+    const auto most =
+        std::max_element(variants.begin(), variants.end(),
+                         [](const auto& a, const auto& b) { return a.second < b.second; });
+    r.recorded_variant = FromLcmVariant(most->first);
+    r.recorded_force_limits = 2 * limited > static_cast<long>(log.diagnostics.size());
+  }
+
+  const auto state_of = IndexBySample(log.estimates);
+  const auto safe_of = IndexBySample(log.safe);
+  std::unordered_map<int64_t, int> diagnostics_of;
+  for (size_t i = 0; i < log.diagnostics.size(); ++i) {
+    diagnostics_of.emplace(log.diagnostics[i].sample_utime, static_cast<int>(i));
+  }
+
+  // Every recorded nominal command with the estimate of the same
+  // sample_utime, as SafetyNode::OnNominal pairs them.
+  safety::SafetyDiagnostics d;
+  std::vector<int64_t> replayed_ns, recorded_ns;
+  std::unordered_map<int64_t, size_t> step_of;
+  r.steps.reserve(log.nominal.size());
+  for (const force_command_t& nominal : log.nominal) {
+    ++r.nominal_commands;
+    const int* state_index = Find(state_of, nominal.sample_utime);
+    if (state_index == nullptr) {
+      ++r.without_state;
+      continue;
+    }
+    const state_t& state = log.estimates[static_cast<size_t>(*state_index)];
+    const Vector6d f =
+        filter.Step(FromArray(state.q), FromArray(state.qd), FromArray(nominal.force_n), &d);
+    SafetyStep step;
+    step.sample_utime = nominal.sample_utime;
+    step.f_replayed = ToStdArray(f);
+    step.replayed_flags = d.flags;
+    step.replayed_case = static_cast<int8_t>(d.filter_case);
+    step.replayed_ns = d.compute_ns;
+    ++r.replayed_cases[static_cast<size_t>(step.replayed_case)];
+    const int* safe_index = Find(safe_of, nominal.sample_utime);
+    if (safe_index == nullptr) {
+      ++r.without_recorded_command;
+      step.kind = SafetyStepKind::kUnrecorded;
+    } else {
+      const force_command_t& recorded = log.safe[static_cast<size_t>(*safe_index)];
+      std::copy(std::begin(recorded.force_n), std::end(recorded.force_n), step.f_recorded.begin());
+      step.recorded_flags = recorded.flags;
+      if (const int* diag_index = Find(diagnostics_of, nominal.sample_utime)) {
+        step.recorded_ns = log.diagnostics[static_cast<size_t>(*diag_index)].compute_ns;
+      }
+      if (IsFallback(recorded.flags)) {
+        ++r.answered_by_fallback;
+        step.kind = SafetyStepKind::kFallback;
+      } else {
+        step.kind = SafetyStepKind::kCompared;
+        const bool flags_equal = recorded.flags == step.replayed_flags;
+        if (!flags_equal) ++r.flags_differ;
+        r.filter.Add(step.sample_utime, step.f_replayed.data(), recorded.force_n, 6, flags_equal);
+        replayed_ns.push_back(step.replayed_ns);
+        if (step.recorded_ns >= 0) recorded_ns.push_back(step.recorded_ns);
+      }
+    }
+    step_of.emplace(step.sample_utime, r.steps.size());
+    r.steps.push_back(step);
+  }
+  r.replayed_ns = ComputeTimeStats(std::move(replayed_ns));
+  r.recorded_ns = ComputeTimeStats(std::move(recorded_ns));
+
+  // Every recorded fallback, replayed along the path the node took
+  // (SafetyNode::PublishFallback, or the filter's own last resort).
+  for (const force_command_t& recorded : log.safe) {
+    if (!IsFallback(recorded.flags)) continue;
+    ++r.fallback_commands;
+    const int* state_index = Find(state_of, recorded.sample_utime);
+    if (state_index == nullptr) {
+      ++r.fallback_without_input;
+      continue;
+    }
+    const state_t& state = log.estimates[static_cast<size_t>(*state_index)];
+    std::array<double, 6> f{};
+    int32_t flags = 0;
+    int32_t node_reason = 0;
+    if (recorded.flags & force_command_t::FLAG_STALE_INPUT) {
+      ++r.fallback_stale_input;
+      node_reason = force_command_t::FLAG_STALE_INPUT;
+    } else if (!StateUsable(state)) {
+      ++r.fallback_invalid_state;
+      node_reason = force_command_t::FLAG_INVALID_INPUT;
+    } else {
+      ++r.fallback_by_filter;
+    }
+    if (node_reason != 0) {
+      f = ToStdArray(filter.SafeStopCommand(FromArray(state.q), FromArray(state.qd), &d));
+      flags = d.flags | node_reason;
+    } else {
+      const size_t* step_index = Find(step_of, recorded.sample_utime);
+      if (step_index == nullptr) {
+        ++r.fallback_without_input;
+        continue;
+      }
+      const SafetyStep& step = r.steps[*step_index];
+      f = step.f_replayed;
+      flags = step.replayed_flags;
+    }
+    r.fallback.Add(recorded.sample_utime, f.data(), recorded.force_n, 6, flags == recorded.flags);
+  }
+  return r;
+}
+
+namespace {
+
+std::optional<int64_t> ControllerTimeOrigin(const RecordedLog& log, bool* inferred) {
+  *inferred = false;
+  const force_command_t* first = nullptr;
+  for (const force_command_t& command : log.nominal) {
+    if (first == nullptr || command.seq < first->seq) first = &command;
+  }
+  if (first == nullptr) return std::nullopt;
+  if (first->seq == 0) return first->sample_utime;
+  // The command period: the median step between recorded consecutive commands.
+  std::vector<int64_t> steps;
+  for (size_t i = 1; i < log.nominal.size(); ++i) {
+    if (log.nominal[i].seq == log.nominal[i - 1].seq + 1) {
+      steps.push_back(log.nominal[i].sample_utime - log.nominal[i - 1].sample_utime);
+    }
+  }
+  if (steps.empty()) return std::nullopt;
+  std::nth_element(steps.begin(), steps.begin() + static_cast<long>(steps.size() / 2), steps.end());
+  *inferred = true;
+  return first->sample_utime - first->seq * steps[steps.size() / 2];
+}
+
+}  // namespace
+
+ControllerReplayResult ReplayController(const StackConfig& config, const Scenario& scenario,
+                                        const RecordedLog& log) {
+  ControllerReplayResult r;
+  r.scenario = scenario.name();
+  Controller controller(config.platform, config.controller, config.home_pose, scenario);
+  const auto recorded_of = IndexBySample(log.nominal);
+  std::unordered_set<int64_t> replayed_samples;
+  const std::optional<int64_t> origin = ControllerTimeOrigin(log, &r.time_origin_inferred);
+  r.time_origin_utime = origin.value_or(-1);
+  bool started = false;
+  // ControllerNode::OnState, per recorded estimate in log order.
+  for (const state_t& state : log.estimates) {
+    ++r.states;
+    if (!StateUsable(state)) {
+      ++r.invalid_states;
+      continue;
+    }
+    ControllerOutput out;
+    if (!started && origin && *origin < state.utime) {
+      // The first state the live controller stepped on is not in the log:
+      // start the clock there (this step's output is not compared).
+      controller.Step(*origin, FromArray(state.q), FromArray(state.qd), &out);
+    }
+    started = true;
+    const StepStatus status =
+        controller.Step(state.utime, FromArray(state.q), FromArray(state.qd), &out);
+    if (status != StepStatus::kOk) {
+      ++r.step_rejected;
+      continue;
+    }
+    ++r.replayed;
+    replayed_samples.insert(state.sample_utime);
+    force_command_t command{};
+    ToArray(out.force_n, command.force_n);
+    command.flags = out.setpoint_rejected ? force_command_t::FLAG_SETPOINT_REJECTED : 0;
+    const int* index = Find(recorded_of, state.sample_utime);
+    if (index == nullptr) {
+      ++r.without_recorded_command;
+      continue;
+    }
+    const force_command_t& recorded = log.nominal[static_cast<size_t>(*index)];
+    const bool flags_equal = recorded.flags == command.flags;
+    if (!flags_equal) ++r.flags_differ;
+    r.nominal.Add(state.sample_utime, command.force_n, recorded.force_n, 6, flags_equal);
+  }
+  r.recorded_commands = static_cast<long>(log.nominal.size());
+  for (const force_command_t& recorded : log.nominal) {
+    if (replayed_samples.count(recorded.sample_utime) == 0) ++r.recorded_without_replay;
+  }
+  return r;
+}
+
+namespace {
+
+// q, qd, q_std, qd_std of a state in one array.
+std::array<double, 24> StateValues(const state_t& s) {
+  std::array<double, 24> v{};
+  std::copy(std::begin(s.q), std::end(s.q), v.begin());
+  std::copy(std::begin(s.qd), std::end(s.qd), v.begin() + 6);
+  std::copy(std::begin(s.q_std), std::end(s.q_std), v.begin() + 12);
+  std::copy(std::begin(s.qd_std), std::end(s.qd_std), v.begin() + 18);
+  return v;
+}
+
+bool EstimateFinite(const state_t& s) {
+  return AllFinite(s.q) && AllFinite(s.qd) && AllFinite(s.q_std) && AllFinite(s.qd_std);
+}
+
+}  // namespace
+
+EstimatorReplayResult ReplayEstimator(const StackConfig& config, const RecordedLog& log) {
+  EstimatorReplayResult r;
+  r.perfect_state = config.estimator.perfect_state;
+  // Up to the first sample or command missing from the log, the replay has
+  // every input the live estimator had.
+  for (Channel input : r.perfect_state
+                           ? std::vector<Channel>{Channel::kStateTruth}
+                           : std::vector<Channel>{Channel::kSensors, Channel::kCommandSafe}) {
+    const SeqGaps& gaps = log.gaps[static_cast<size_t>(input)];
+    if (gaps.gaps == 0) continue;
+    if (r.inputs_missing == 0 || gaps.intact_until_utime < r.inputs_intact_until_utime) {
+      r.inputs_intact_until_utime = gaps.intact_until_utime;
+    }
+    r.inputs_missing += gaps.missing;
+  }
+  const auto recorded_of = IndexBySample(log.estimates);
+  std::unordered_set<int64_t> replayed_samples;
+  int64_t seq = 0;
+  auto compare = [&](const state_t& replayed) {
+    // EstimatorNode::Publish drops non-finite estimates.
+    if (!EstimateFinite(replayed)) return;
+    ++r.replayed;
+    ++seq;
+    replayed_samples.insert(replayed.sample_utime);
+    const int* index = Find(recorded_of, replayed.sample_utime);
+    if (index == nullptr) {
+      ++r.without_recorded_estimate;
+      return;
+    }
+    const state_t& recorded = log.estimates[static_cast<size_t>(*index)];
+    const bool intact =
+        r.inputs_missing == 0 || replayed.sample_utime <= r.inputs_intact_until_utime;
+    const bool status_equal = recorded.status == replayed.status;
+    if (!status_equal && intact) ++r.status_differ;
+    const auto a = StateValues(replayed);
+    const auto b = StateValues(recorded);
+    (intact ? r.state : r.after_gap)
+        .Add(replayed.sample_utime, a.data(), b.data(), static_cast<int>(a.size()),
+             status_equal && recorded.utime == replayed.utime);
+    double& max_q = intact ? r.max_abs_diff_q : r.max_abs_diff_q_after_gap;
+    double& max_qd = intact ? r.max_abs_diff_qd : r.max_abs_diff_qd_after_gap;
+    double& max_sigma = intact ? r.max_diff_sigma : r.max_diff_sigma_after_gap;
+    // In sigmas of the difference of two estimates: hypot(std_a, std_b).
+    auto sigmas = [](double diff, double std_a, double std_b) {
+      const double std = std::hypot(std_a, std_b);
+      return std > 0.0 ? diff / std : 0.0;
+    };
+    for (int i = 0; i < 6; ++i) {
+      const double dq = std::fabs(replayed.q[i] - recorded.q[i]);
+      const double dqd = std::fabs(replayed.qd[i] - recorded.qd[i]);
+      max_q = std::fmax(max_q, dq);
+      max_qd = std::fmax(max_qd, dqd);
+      max_sigma =
+          std::fmax(max_sigma, std::fmax(sigmas(dq, recorded.q_std[i], replayed.q_std[i]),
+                                         sigmas(dqd, recorded.qd_std[i], replayed.qd_std[i])));
+    }
+  };
+
+  if (r.perfect_state) {
+    // EstimatorNode::OnTruth: the ground truth, republished.
+    for (const state_t& truth : log.truth) {
+      if (!AllFinite(truth.q) || !AllFinite(truth.qd)) continue;
+      state_t state = truth;
+      state.seq = seq;
+      state.status = state_t::STATUS_VALID | state_t::STATUS_PERFECT_STATE;
+      compare(state);
+    }
+  } else {
+    // EstimatorNode::OnCommand / OnSensor, in the order the log received them.
+    Ekf ekf(config.platform, config.actuators, config.sensors, config.estimator, config.home_pose);
+    for (const auto& [channel, index] : log.order) {
+      if (channel == Channel::kCommandSafe) {
+        const force_command_t& command = log.safe[static_cast<size_t>(index)];
+        ++r.commands;
+        if (!AllFinite(command.force_n)) {
+          ++r.rejected_commands;
+          continue;
+        }
+        ekf.SetForceCommand(command.sample_utime, FromArray(command.force_n));
+      } else if (channel == Channel::kSensors) {
+        ++r.sensor_samples;
+        const UpdateResult result =
+            ekf.Update(SampleFromMessage(log.sensors[static_cast<size_t>(index)]));
+        if (result.has_estimate) compare(StateFromEstimate(ekf.estimate(), seq));
+      }
+    }
+  }
+  r.recorded_estimates = static_cast<long>(log.estimates.size());
+  for (const state_t& recorded : log.estimates) {
+    if (replayed_samples.count(recorded.sample_utime) == 0) ++r.recorded_without_replay;
+  }
+  return r;
+}
+
+}  // namespace stewart::replay

@@ -1,0 +1,312 @@
+#include "replay_output.h"
+
+#include <spdlog/fmt/fmt.h>
+
+#include <cmath>
+#include <iomanip>
+
+namespace stewart::replay {
+namespace {
+
+using nlohmann::ordered_json;
+
+constexpr const char* kCaseNames[6] = {"none", "position",   "velocity",
+                                       "both", "infeasible", "fallback"};
+
+const char* KindName(SafetyStepKind kind) {
+  switch (kind) {
+    case SafetyStepKind::kCompared:
+      return "compared";
+    case SafetyStepKind::kFallback:
+      return "fallback";
+    case SafetyStepKind::kUnrecorded:
+      return "unrecorded";
+  }
+  return "?";
+}
+
+// JSON has no inf or NaN: null instead.
+ordered_json Number(double value) {
+  return std::isfinite(value) ? ordered_json(value) : ordered_json(nullptr);
+}
+
+ordered_json ToJson(const DiffStats& d, const char* unit_suffix) {
+  ordered_json j;
+  j["compared"] = d.compared;
+  j["identical"] = d.identical;
+  j[std::string("max_abs_diff") + unit_suffix] = Number(d.max_abs_diff);
+  j["max_rel_diff"] = Number(d.max_rel_diff);
+  j["worst_sample_utime"] = d.worst_sample_utime;
+  return j;
+}
+
+ordered_json ToJson(const TimeStats& t) {
+  ordered_json j;
+  j["count"] = t.count;
+  j["p50"] = t.count ? Number(t.p50_ns) : ordered_json(nullptr);
+  j["p99"] = t.count ? Number(t.p99_ns) : ordered_json(nullptr);
+  j["max"] = t.count ? Number(t.max_ns) : ordered_json(nullptr);
+  return j;
+}
+
+std::string Us(const TimeStats& t) {
+  if (t.count == 0) return "n/a";
+  return fmt::format("p50 {:.2f} us, p99 {:.2f} us", t.p50_ns * 1e-3, t.p99_ns * 1e-3);
+}
+
+std::string Identical(const DiffStats& d) {
+  return fmt::format("{} compared, {} bit-identical", d.compared, d.identical);
+}
+
+std::string Worst(const DiffStats& d, const char* unit) {
+  if (d.max_abs_diff == 0.0) return fmt::format("max |d| 0 {}", unit);
+  return fmt::format("max |d| {:.3g} {} (sample_utime {}), max relative {:.3g}", d.max_abs_diff,
+                     unit, d.worst_sample_utime, d.max_rel_diff);
+}
+
+double StackDurationS(const RecordedLog& log) {
+  return log.first_utime < 0 ? 0.0 : 1e-6 * static_cast<double>(log.last_utime - log.first_utime);
+}
+
+}  // namespace
+
+long ReplayReport::Differing() const {
+  long n = 0;
+  if (safety) n += safety->filter.differing() + safety->fallback.differing();
+  if (controller) n += controller->nominal.differing();
+  if (estimator) n += estimator->state.differing();
+  return n;
+}
+
+long ReplayReport::Compared() const {
+  long n = 0;
+  if (safety) n += safety->filter.compared + safety->fallback.compared;
+  if (controller) n += controller->nominal.compared;
+  if (estimator) n += estimator->state.compared;
+  return n;
+}
+
+ordered_json ToJson(const ReplayReport& report) {
+  ordered_json j;
+  j["tool"] = "stewart_replay";
+  j["run"] = report.run_dir;
+  j["log"] = report.log_path;
+  j["config"] = report.config_path;
+  if (!report.scenario_path.empty()) j["scenario"] = report.scenario_path;
+  const RecordedLog& log = *report.log;
+  j["log_events"] = log.events;
+  j["log_wall_duration_s"] =
+      1e-6 * static_cast<double>(log.last_timestamp_us - log.first_timestamp_us);
+  j["stack_duration_s"] = StackDurationS(log);
+  j["undecodable"] = log.undecodable;
+  ordered_json gaps = ordered_json::object();
+  for (size_t c = 0; c < log.gaps.size(); ++c) {
+    if (log.gaps[c].gaps == 0) continue;
+    gaps[log.channel_names[c]] = {{"missing", log.gaps[c].missing},
+                                  {"gaps", log.gaps[c].gaps},
+                                  {"intact_until_utime", log.gaps[c].intact_until_utime}};
+  }
+  j["log_gaps"] = gaps;
+
+  if (report.safety) {
+    const SafetyReplayResult& s = *report.safety;
+    ordered_json js;
+    js["variant"] = ToString(s.variant);
+    js["variant_source"] = report.variant_source;
+    js["qp_solver"] = s.qp_solver.empty() ? ordered_json(nullptr) : ordered_json(s.qp_solver);
+    js["force_limits"] = s.force_limits;
+    js["k_position"] = s.k_position;
+    js["k_velocity"] = s.k_velocity;
+    js["recorded_variant"] =
+        s.recorded_variant ? ordered_json(ToString(*s.recorded_variant)) : ordered_json(nullptr);
+    js["recorded_force_limits"] =
+        s.recorded_force_limits ? ordered_json(*s.recorded_force_limits) : ordered_json(nullptr);
+    js["nominal_commands"] = s.nominal_commands;
+    js["without_state"] = s.without_state;
+    js["without_recorded_command"] = s.without_recorded_command;
+    js["answered_by_fallback"] = s.answered_by_fallback;
+    js.update(ToJson(s.filter, "_n"));
+    js["flags_differ"] = s.flags_differ;
+    ordered_json fallback;
+    fallback["recorded"] = s.fallback_commands;
+    fallback["stale_input"] = s.fallback_stale_input;
+    fallback["invalid_state"] = s.fallback_invalid_state;
+    fallback["by_filter"] = s.fallback_by_filter;
+    fallback["without_input"] = s.fallback_without_input;
+    fallback.update(ToJson(s.fallback, "_n"));
+    js["fallback"] = fallback;
+    js["compute_ns"] = {{"replayed", ToJson(s.replayed_ns)}, {"recorded", ToJson(s.recorded_ns)}};
+    ordered_json cases;
+    for (size_t i = 0; i < 6; ++i) cases[kCaseNames[i]] = s.replayed_cases[i];
+    js["replayed_cases"] = cases;
+    j["safety"] = js;
+  }
+  if (report.controller) {
+    const ControllerReplayResult& c = *report.controller;
+    ordered_json jc;
+    jc["scenario"] = c.scenario;
+    jc["time_origin_utime"] = c.time_origin_utime;
+    jc["time_origin_inferred"] = c.time_origin_inferred;
+    jc["states"] = c.states;
+    jc["invalid_states"] = c.invalid_states;
+    jc["step_rejected"] = c.step_rejected;
+    jc["replayed"] = c.replayed;
+    jc["recorded_commands"] = c.recorded_commands;
+    jc["without_recorded_command"] = c.without_recorded_command;
+    jc["recorded_without_replay"] = c.recorded_without_replay;
+    jc.update(ToJson(c.nominal, "_n"));
+    jc["flags_differ"] = c.flags_differ;
+    j["controller"] = jc;
+  }
+  if (report.estimator) {
+    const EstimatorReplayResult& e = *report.estimator;
+    ordered_json je;
+    je["perfect_state"] = e.perfect_state;
+    je["sensor_samples"] = e.sensor_samples;
+    je["commands"] = e.commands;
+    je["rejected_commands"] = e.rejected_commands;
+    je["replayed"] = e.replayed;
+    je["recorded_estimates"] = e.recorded_estimates;
+    je["without_recorded_estimate"] = e.without_recorded_estimate;
+    je["recorded_without_replay"] = e.recorded_without_replay;
+    je.update(ToJson(e.state, ""));
+    je["max_abs_diff_q"] = Number(e.max_abs_diff_q);
+    je["max_abs_diff_qd"] = Number(e.max_abs_diff_qd);
+    je["max_diff_sigma"] = Number(e.max_diff_sigma);
+    je["status_differ"] = e.status_differ;
+    je["inputs_missing"] = e.inputs_missing;
+    je["inputs_intact_until_utime"] = e.inputs_intact_until_utime;
+    ordered_json after = ToJson(e.after_gap, "");
+    after["max_abs_diff_q"] = Number(e.max_abs_diff_q_after_gap);
+    after["max_abs_diff_qd"] = Number(e.max_abs_diff_qd_after_gap);
+    after["max_diff_sigma"] = Number(e.max_diff_sigma_after_gap);
+    je["after_gap"] = after;
+    j["estimator"] = je;
+  }
+  j["compared"] = report.Compared();
+  j["differing"] = report.Differing();
+  j["identical"] = report.Differing() == 0;
+  return j;
+}
+
+std::string FormatSummary(const ReplayReport& report) {
+  const RecordedLog& log = *report.log;
+  std::string o = fmt::format("stewart_replay: {}\n", report.run_dir);
+  o += fmt::format("  log     {}: {} events, {:.3f} s of stack time (logged in {:.1f} s)",
+                   report.log_path, log.events, StackDurationS(log),
+                   1e-6 * static_cast<double>(log.last_timestamp_us - log.first_timestamp_us));
+  for (const auto& [channel, count] : log.undecodable) {
+    o += fmt::format(", {} undecodable on {}", count, channel);
+  }
+  for (size_t c = 0; c < log.gaps.size(); ++c) {
+    if (log.gaps[c].gaps == 0) continue;
+    o += fmt::format(
+        "\n  log gap {}: {} messages published but not in the log ({} burst(s), the first after "
+        "utime {})",
+        log.channel_names[c], log.gaps[c].missing, log.gaps[c].gaps,
+        log.gaps[c].intact_until_utime);
+  }
+  o += fmt::format("\n  config  {}\n", report.config_path);
+  if (!report.scenario_path.empty()) o += fmt::format("  scenario {}\n", report.scenario_path);
+
+  if (report.safety) {
+    const SafetyReplayResult& s = *report.safety;
+    o += fmt::format(
+        "\nSafety filter: variant {}{} (from {}), force limits {}, k_position {:g}, "
+        "k_velocity {:g}; live filter: {}{}\n",
+        ToString(s.variant), s.qp_solver.empty() ? "" : " [" + s.qp_solver + "]",
+        report.variant_source, s.force_limits ? "on" : "off", s.k_position, s.k_velocity,
+        s.recorded_variant ? ToString(*s.recorded_variant) : "no diagnostics",
+        s.recorded_force_limits && *s.recorded_force_limits ? ", force limits on" : "");
+    o += fmt::format(
+        "  nominal commands      {} ({} without an estimate, {} without a recorded safe "
+        "command)\n",
+        s.nominal_commands, s.without_state, s.without_recorded_command);
+    o += fmt::format("  filter commands       {}; {}; flags differ {}\n", Identical(s.filter),
+                     Worst(s.filter, "N"), s.flags_differ);
+    o += fmt::format(
+        "  answered by fallback  {} nominal commands (the live node sent a fallback; not "
+        "compared above)\n",
+        s.answered_by_fallback);
+    o += fmt::format(
+        "  fallback commands     {} recorded: {} stale input, {} invalid state, {} filter last "
+        "resort, {} not replayable; {}; {}\n",
+        s.fallback_commands, s.fallback_stale_input, s.fallback_invalid_state, s.fallback_by_filter,
+        s.fallback_without_input, Identical(s.fallback), Worst(s.fallback, "N"));
+    o += fmt::format("  filter time per step  replay {} | live {} ({} steps)\n", Us(s.replayed_ns),
+                     Us(s.recorded_ns), s.replayed_ns.count);
+    o += "  replayed cases       ";
+    for (size_t i = 0; i < 6; ++i) {
+      if (s.replayed_cases[i]) o += fmt::format(" {} {}", kCaseNames[i], s.replayed_cases[i]);
+    }
+    o += "\n";
+  }
+  if (report.controller) {
+    const ControllerReplayResult& c = *report.controller;
+    o += fmt::format("\nController: scenario '{}', clock from utime {}{}\n", c.scenario,
+                     c.time_origin_utime,
+                     c.time_origin_inferred ? " (inferred: the log lacks the first command)" : "");
+    o += fmt::format(
+        "  states                {} ({} not valid: skipped, {} rejected by the controller)\n",
+        c.states, c.invalid_states, c.step_rejected);
+    o += fmt::format("  nominal commands      {} replayed, {} recorded; {}; {}; flags differ {}\n",
+                     c.replayed, c.recorded_commands, Identical(c.nominal), Worst(c.nominal, "N"),
+                     c.flags_differ);
+    o += fmt::format(
+        "  unmatched             {} replayed without a recorded one, {} recorded "
+        "without a replayed one\n",
+        c.without_recorded_command, c.recorded_without_replay);
+  }
+  if (report.estimator) {
+    const EstimatorReplayResult& e = *report.estimator;
+    o += fmt::format("\nEstimator{}\n",
+                     e.perfect_state ? " (perfect state: truth republished)" : "");
+    o += fmt::format("  inputs                {} sensor samples, {} safe commands ({} rejected)\n",
+                     e.sensor_samples, e.commands, e.rejected_commands);
+    o += fmt::format(
+        "  estimates             {} replayed, {} recorded; {}; max |dq| {:.3g}, max |dqd| {:.3g}, "
+        "status differs {}\n",
+        e.replayed, e.recorded_estimates, Identical(e.state), e.max_abs_diff_q, e.max_abs_diff_qd,
+        e.status_differ);
+    o += fmt::format(
+        "  unmatched             {} replayed without a recorded one, {} recorded "
+        "without a replayed one\n",
+        e.without_recorded_estimate, e.recorded_without_replay);
+    if (e.inputs_missing > 0) {
+      o += fmt::format(
+          "  after the log gap     {} inputs missing from the log after utime {}: the {} later "
+          "estimates are not comparable (not counted above): {} bit-identical, max |dq| {:.3g}, "
+          "max |dqd| {:.3g}, max {:.3g} sigma\n",
+          e.inputs_missing, e.inputs_intact_until_utime, e.after_gap.compared,
+          e.after_gap.identical, e.max_abs_diff_q_after_gap, e.max_abs_diff_qd_after_gap,
+          e.max_diff_sigma_after_gap);
+    }
+  }
+  const long differing = report.Differing();
+  if (differing == 0) {
+    o += fmt::format("\nResult: all {} compared outputs are bit-identical to the recorded ones.\n",
+                     report.Compared());
+  } else {
+    o += fmt::format("\nResult: {} of {} compared outputs differ from the recorded ones.\n",
+                     differing, report.Compared());
+  }
+  return o;
+}
+
+void WriteSafetyStepsCsv(const SafetyReplayResult& safety, std::ostream& out) {
+  out << "sample_utime_us,kind,replayed_flags,recorded_flags,replayed_case,replayed_ns,"
+         "recorded_ns";
+  for (int i = 0; i < 6; ++i) out << ",f_replayed" << i << "_n";
+  for (int i = 0; i < 6; ++i) out << ",f_recorded" << i << "_n";
+  out << '\n' << std::setprecision(17);
+  for (const SafetyStep& step : safety.steps) {
+    out << step.sample_utime << ',' << KindName(step.kind) << ',' << step.replayed_flags << ','
+        << step.recorded_flags << ',' << static_cast<int>(step.replayed_case) << ','
+        << step.replayed_ns << ',' << step.recorded_ns;
+    for (double f : step.f_replayed) out << ',' << f;
+    for (double f : step.f_recorded) out << ',' << f;
+    out << '\n';
+  }
+}
+
+}  // namespace stewart::replay
