@@ -25,11 +25,12 @@ usage: tools/launch.sh [options]
   --lcm-url URL         use this URL instead of a private one
   --out DIR             run folder (default: runs/<date>-<scenario>)
   --no-build            use the build as it is (skip tools/setup.sh; tests use this)
+  --lcm-logger          record with the packaged lcm-logger instead of stewart_logger
 USAGE
 }
 
 PLANT=sim MODE="" SCENARIO=paper CONFIG="$ROOT/config/platform.yaml" VARIANT="" DURATION=""
-LOG="" DO_LOG=1 DO_REPORT=1 SPY=0 URL="" OUT="" EMULATOR=0 BUILD_FIRST=1
+LOG="" DO_LOG=1 DO_REPORT=1 SPY=0 URL="" OUT="" EMULATOR=0 BUILD_FIRST=1 LCM_LOGGER=0
 ARGS="$*"
 while (($#)); do
   case "$1" in
@@ -48,6 +49,7 @@ while (($#)); do
     --lcm-url) URL=$2; shift ;;
     --out) OUT=$(realpath -m "$2"); shift ;;
     --no-build) BUILD_FIRST=0 ;;
+    --lcm-logger) LCM_LOGGER=1 ;;
     -h|--help) usage; exit 0 ;;
     *) echo "launch: unknown option '$1'" >&2; usage >&2; exit 2 ;;
   esac
@@ -68,7 +70,7 @@ bin() { # path of a built program, or fail naming it
   echo "$p"
 }
 PLANT_SIM=$(bin plant_sim) ESTIMATOR=$(bin estimator) CONTROLLER=$(bin controller)
-SAFETY=$(bin safety) MONITOR=$(bin stewart_stack_monitor)
+SAFETY=$(bin safety) MONITOR=$(bin stewart_stack_monitor) LOGGER=$(bin stewart_logger)
 
 [[ -n $DURATION ]] || DURATION=$("$CONTROLLER" --config "$CONFIG" --scenario "$SCENARIO" --print-duration)
 STAMP=$(date +%Y%m%d-%H%M%S)
@@ -128,8 +130,16 @@ fail() { # name of the process that died
 trap 'echo; echo "launch: interrupted, stopping every process"; stop_all; exit 130' INT TERM
 
 if ((DO_LOG)); then
-  # lcm-logger 1.3.1: '-l URL' is rejected, use --lcm-url=URL.
-  start logger lcm-logger --lcm-url="$URL" -f "$LOG"
+  if ((LCM_LOGGER)); then
+    # lcm-logger 1.3.1: '-l URL' is rejected, use --lcm-url=URL. It drops
+    # bursts when descheduled (30-message queue): docs/operations.md.
+    start logger lcm-logger --lcm-url="$URL" -f "$LOG"
+  else
+    # A 4 MB socket buffer (capped by net.core.rmem_max): the logger takes
+    # every message of the bus and must survive being descheduled.
+    if [[ $URL == *\?* ]]; then LOG_URL="$URL&recv_buf_size=4194304"; else LOG_URL="$URL?recv_buf_size=4194304"; fi
+    start logger "$LOGGER" --lcm-url="$LOG_URL" -f "$LOG"
+  fi
   echo "   recording:  $LOG"
 fi
 if ((SPY)); then start lcm-spy "$ROOT/tools/lcm-spy" --lcm-url="$URL"; fi

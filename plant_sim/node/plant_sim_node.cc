@@ -216,6 +216,10 @@ int PlantSimNode::RunRealTime() {
   return 0;
 }
 
+namespace {
+constexpr std::chrono::milliseconds kStallResend(200);
+}  // namespace
+
 int PlantSimNode::RunLockstep() {
   utime0_ = std::max<int64_t>(options_.start_utime, 0);
   const auto timeout = std::chrono::duration_cast<Clock::duration>(
@@ -242,12 +246,21 @@ int PlantSimNode::RunLockstep() {
         health_.SetError(what);
         return 3;
       }
-      if (tick_ == 0 && options_.startup_republish_s > 0.0 && now - last_sent >= republish) {
+      // Resend the awaited sample: at start-up until the stack has
+      // subscribed, later when the loop stalls. On a saturated machine a
+      // multicast datagram was seen to wait in the kernel for seconds (or is
+      // lost), and lockstep has nothing else to move it along; a receiver
+      // that already has the sample rejects the copy by its utime.
+      const Clock::duration resend_every = tick_ == 0 ? republish : kStallResend;
+      const bool resend_enabled = tick_ > 0 || options_.startup_republish_s > 0.0;
+      if (resend_enabled && now - last_sent >= resend_every) {
         // The stored message, byte for byte: a new draw would change the noise sequence.
         lcm_->publish(config_.lcm.channels.sensors, &last_sensor_);
+        if (tick_ > 0) health_.Count("lockstep_resends");
         last_sent = now;
       }
-      lcm_->handleTimeout(TimeoutMs(timeout - (now - waiting_since)));
+      const Clock::duration remaining = timeout - (now - waiting_since);
+      lcm_->handleTimeout(TimeoutMs(std::min<Clock::duration>(remaining, resend_every)));
       health_.MaybePublish(lcm_.get());
     }
     plant_.SetForceCommand(answer_force_n_);
