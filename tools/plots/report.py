@@ -37,6 +37,23 @@ def load(run, channel_key, config):
             if k not in ("name", "counters", "last_error")}
 
 
+def plant_counters(run, config):
+    """Counters of the plant process (plant_sim or hw_bridge) from its last health message."""
+    lcm = config["lcm"]
+    name = lcm["channel_prefix"] + lcm["channels"]["health"] + (lcm.get("channel_suffix") or "")
+    path = os.path.join(run, "csv", name + ".csv")
+    if not os.path.exists(path):
+        return {}
+    last = None
+    with open(path) as f:
+        for row in csv.DictReader(f):
+            if row["name"] in ("plant_sim", "hw_bridge"):
+                last = row
+    if last is None or not last["counters"]:
+        return {}
+    return dict(item.split("=", 1) for item in last["counters"].split(";") if "=" in item)
+
+
 def percentile(values, p):
     return float(np.percentile(values, p)) if len(values) else float("nan")
 
@@ -188,6 +205,15 @@ def main():
                   f"command derived from it: p50 {percentile(lat, 50):.0f} us, p99 "
                   f"{percentile(lat, 99):.0f} us, max {lat.max():.0f} us over {len(lat)} "
                   f"commands; {len(sensors['seq']) - len(lat)} samples had no safe command.", ""]
+
+        counters = plant_counters(run, config)
+        if counters:
+            keys = [k for k in ("missed_ticks", "overrun_ticks", "lockstep_resends",
+                                "command_timeouts", "endstop_hits", "ticks") if k in counters]
+            lines += ["Plant counters at the end (its last health message): " +
+                      ", ".join(f"{k} {counters[k]}" for k in keys) +
+                      ". missed_ticks: ticks whose previous sample got no command in time "
+                      "(real time; includes the start-up before the stack answers).", ""]
 
     lines += replay_section(run)
 
