@@ -74,6 +74,15 @@ void BM_ClosedFormFullStep(benchmark::State& state) {
 }
 BENCHMARK(BM_ClosedFormFullStep);
 
+// (a) with the paper's force metric (no metric map per step).
+void BM_ClosedFormCoreForceMetric(benchmark::State& state) {
+  SafetyConfig s = Config().safety;
+  s.correction_metric = CorrectionMetric::kForce;
+  SafetyFilter filter(Config().platform, s, Config().actuators);
+  RunCore(state, &filter);
+}
+BENCHMARK(BM_ClosedFormCoreForceMetric);
+
 void BM_PaperRuleCore(benchmark::State& state) {
   SafetyConfig s = Config().safety;
   s.variant = SafetyVariant::kPaperRule;

@@ -59,6 +59,7 @@ int main(int argc, char** argv) {
         const auto& b = d.barriers;
         out["f_safe"] = ToJson(f);
         out["variant"] = stewart::ToString(d.variant);
+        out["correction_metric"] = stewart::ToString(filter.correction_metric());
         out["case"] = static_cast<int>(d.filter_case);
         out["infeasible"] = d.infeasible;
         out["flags"] = d.flags;

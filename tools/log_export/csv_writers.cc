@@ -112,7 +112,8 @@ class DiagnosticsWriter : public TypedWriter<safety_diagnostics_t> {
   // Barrier arrays vary in length between configs; the CSV keeps the
   // composed quantities, which every config has, plus the first barriers.
   std::string Columns() const override {
-    return ",variant,active_case,infeasible,fallback_reason,h_pos,h_vel,psi_p,psi_v,mu_p,mu_v" +
+    return ",variant,correction_metric,active_case,infeasible,fallback_reason,h_pos,h_vel,psi_p,"
+           "psi_v,mu_p,mu_v" +
            IndexedColumns("g_p", 6, "") + IndexedColumns("g_v", 6, "") +
            IndexedColumns("f_des", 6, "n") + IndexedColumns("f_safe", 6, "n") +
            IndexedColumns("mu_force", 6, "") + ",correction_norm_n,compute_ns,num_position," +
@@ -120,9 +121,9 @@ class DiagnosticsWriter : public TypedWriter<safety_diagnostics_t> {
            IndexedColumns("h_velocity", 8, "");
   }
   void Row(const safety_diagnostics_t& m, std::ostream& out) const override {
-    out << ',' << int{m.variant} << ',' << int{m.active_case} << ',' << int{m.infeasible} << ','
-        << m.fallback_reason << ',' << m.h_pos << ',' << m.h_vel << ',' << m.psi_p << ',' << m.psi_v
-        << ',' << m.mu_p << ',' << m.mu_v;
+    out << ',' << int{m.variant} << ',' << int{m.correction_metric} << ',' << int{m.active_case}
+        << ',' << int{m.infeasible} << ',' << m.fallback_reason << ',' << m.h_pos << ',' << m.h_vel
+        << ',' << m.psi_p << ',' << m.psi_v << ',' << m.mu_p << ',' << m.mu_v;
     Values(out, m.g_p);
     Values(out, m.g_v);
     Values(out, m.f_des);

@@ -29,6 +29,9 @@ inline void FillDiagnosticsMessage(const SafetyFilter& filter, const SafetyDiagn
   const ConstraintSet& c = filter.constraints();
   const BarrierEvaluation& b = d.barriers;
   msg->variant = ToLcmVariant(d.variant);
+  msg->correction_metric = filter.correction_metric() == CorrectionMetric::kAcceleration
+                               ? safety_diagnostics_t::METRIC_ACCELERATION
+                               : safety_diagnostics_t::METRIC_FORCE;
   msg->active_case = static_cast<std::int8_t>(d.filter_case);
   msg->infeasible = d.infeasible;
   msg->fallback_reason = d.flags & (kFlagInfeasible | kFlagFallback | kFlagInvalidInput);
