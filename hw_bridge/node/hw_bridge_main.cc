@@ -140,6 +140,7 @@ class BridgeNode {
     health_.SetCounter("zero_drive", bridge_.last_reason() != hw::DriveReason::kCommand ? 1 : 0);
     health_.SetCounter("force_clamped", static_cast<int64_t>(c.force_clamped));
     health_.SetCounter("duty_clamped", static_cast<int64_t>(c.duty_clamped));
+    health_.SetCounter("force_deadzoned", static_cast<int64_t>(c.force_deadzoned));
     health_.SetCounter("leg_fault_samples", static_cast<int64_t>(c.leg_fault_samples));
     health_.SetCounter("imu_fault_samples", static_cast<int64_t>(c.imu_fault_samples));
     health_.SetCounter("device_watchdog_samples", static_cast<int64_t>(c.device_watchdog_samples));

@@ -140,6 +140,7 @@ std::size_t HwBridge::BuildCommandFrame(int64_t host_now_us, uint8_t* out) {
     for (int i = 0; i < kNumLegs; ++i) {
       counters_.force_clamped += (drive.force_clamped_mask >> i) & 1U;
       counters_.duty_clamped += (drive.duty_clamped_mask >> i) & 1U;
+      counters_.force_deadzoned += (drive.deadzone_mask >> i) & 1U;
     }
   } else {
     // Zero drive: the P-16P's lead screw holds its length unpowered.

@@ -26,6 +26,8 @@ DriveResult DriveMap::ForceToDrive(const Vector6d& force_n) const {
     if (std::abs(f_c) >= force_deadzone_n_ && f_c != 0.0) {
       duty = std::copysign(
           duty_deadband_ + (1.0 - duty_deadband_) * std::abs(f_c) / force_at_full_duty_n_, f_c);
+    } else if (f_c != 0.0) {
+      result.deadzone_mask |= static_cast<uint8_t>(1U << i);
     }
     if (std::abs(duty) > max_duty_) {
       duty = std::copysign(max_duty_, duty);

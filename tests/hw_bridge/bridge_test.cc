@@ -98,6 +98,26 @@ TEST_F(BridgeTest, FreshCommandIsMappedAndStaleOneZeroed) {
   for (int16_t d : f.command.drive) EXPECT_EQ(d, 0);
 }
 
+TEST_F(BridgeTest, ForcesInTheDeadZoneAreCounted) {
+  // A commanded force the dead zone drops is counted per leg and frame: the
+  // rest of the stack assumes the commanded force acts.
+  hw_.force_deadzone_n = 0.5;
+  HwBridge bridge(hw_, 0.385, 0.2, 100.0);
+  SensorFrame frame;
+  frame.adc.fill(2000);
+  SensorSample sample;
+  ASSERT_TRUE(bridge.OnSensorFrame(frame, kHostEpoch, &sample));
+  Vector6d force = Vector6d::Constant(2.0);
+  force(1) = 0.3;
+  force(4) = -0.2;
+  ASSERT_EQ(bridge.OnForceCommand(sample.utime, force), CommandVerdict::kAccepted);
+  std::array<uint8_t, kMaxFrameSize> buffer{};
+  bridge.BuildCommandFrame(kHostEpoch, buffer.data());
+  bridge.BuildCommandFrame(kHostEpoch + 500, buffer.data());
+  EXPECT_EQ(bridge.counters().force_deadzoned, 4U);
+  EXPECT_EQ(bridge.counters().zero_drive_frames, 0U);
+}
+
 TEST_F(BridgeTest, NonFiniteCommandZeroesUntilAValidOne) {
   Deliver(0);
   ASSERT_EQ(bridge_.OnForceCommand(sample_.utime, Vector6d::Constant(10.0)),

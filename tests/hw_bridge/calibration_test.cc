@@ -87,6 +87,7 @@ TEST_F(DriveMapTest, FollowsTheDocumentedMapAndInverts) {
   EXPECT_EQ(r.drive[3], std::lround((0.1 + 0.9 * 30.0 / 120.0) * 32767));
   EXPECT_EQ(r.force_clamped_mask, 0);
   EXPECT_EQ(r.duty_clamped_mask, 0);
+  EXPECT_EQ(r.deadzone_mask, 0b000010);  // 0.4 N commanded, not applied; 0 N is no loss
   const Vector6d back = map.DriveToForce(r.drive);
   for (int i = 2; i < 6; ++i) EXPECT_NEAR(back(i), f(i), 120.0 / 32767 * 2) << i;
   EXPECT_EQ(back(1), 0.0);

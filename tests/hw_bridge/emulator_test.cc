@@ -1,9 +1,15 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <memory>
+#include <vector>
+
 #include "stewart/hw_bridge/bridge.h"
 #include "stewart/hw_emulator/device_emulator.h"
-#include "stewart/hw_emulator/model_backend.h"
+#include "stewart/hw_emulator/plant_backend.h"
 #include "stewart/model/kinematics.h"
+#include "stewart/plant_sim/plant.h"
+#include "stewart/plant_sim/sensor_model.h"
 #include "test_config.h"
 
 namespace stewart::hw {
@@ -11,9 +17,17 @@ namespace {
 
 class RecordingBackend : public DeviceBackend {
  public:
-  void Step(const DriveArray& drive, double) override { last = drive; }
+  struct Segment {
+    DriveArray drive{};
+    double dt_s = 0.0;
+  };
+  void Step(const DriveArray& drive, double dt_s) override {
+    last = drive;
+    segments.push_back({drive, dt_s});
+  }
   RawReadings Sample() override { return {}; }
   DriveArray last{};
+  std::vector<Segment> segments;
 };
 
 CommandFrame Command(uint32_t seq, int16_t drive, uint32_t watchdog_us = 50000) {
@@ -27,22 +41,22 @@ CommandFrame Command(uint32_t seq, int16_t drive, uint32_t watchdog_us = 50000) 
 TEST(DeviceWatchdog, ZeroDriveWhenCommandsStop) {
   RecordingBackend backend;
   DeviceEmulator device(&backend);
-  SensorFrame f = device.Tick(1000, 1e-3);
+  SensorFrame f = device.Tick(1000);
   EXPECT_NE(f.status & kStatusActuatorsOff, 0);  // no command yet
   device.OnCommandFrame(Command(1, 5000, 20000), 1000);
-  f = device.Tick(2000, 1e-3);
+  f = device.Tick(2000);
   EXPECT_EQ(backend.last[0], 5000);
   EXPECT_EQ(f.status, 0);
   EXPECT_EQ(f.last_command_seq, 1U);
   EXPECT_EQ(f.command_age_us, 1000U);
-  f = device.Tick(21000, 1e-3);  // exactly the watchdog period: still in force
+  f = device.Tick(21000);  // exactly the watchdog period: still in force
   EXPECT_EQ(backend.last[0], 5000);
-  f = device.Tick(21001, 1e-3);
+  f = device.Tick(21001);
   EXPECT_EQ(backend.last[0], 0);
   EXPECT_NE(f.status & kStatusWatchdog, 0);
   EXPECT_EQ(f.applied_drive[0], 0);
   device.OnCommandFrame(Command(2, 7000, 20000), 22000);  // commands resume
-  f = device.Tick(23000, 1e-3);
+  f = device.Tick(23000);
   EXPECT_EQ(backend.last[0], 7000);
   EXPECT_EQ(f.status & kStatusWatchdog, 0);
 }
@@ -53,71 +67,222 @@ TEST(DeviceWatchdog, EnableBitOffAndSeqBookkeeping) {
   CommandFrame c = Command(10, 3000);
   c.flags = 0;
   device.OnCommandFrame(c, 0);
-  SensorFrame f = device.Tick(1000, 1e-3);
+  SensorFrame f = device.Tick(1000);
   EXPECT_EQ(backend.last[0], 0);
   EXPECT_NE(f.status & kStatusActuatorsOff, 0);
   device.OnCommandFrame(Command(14, 3000), 1000);   // 11..13 lost
   device.OnCommandFrame(Command(12, -3000), 1100);  // reordered: ignored
   device.OnRxError();
-  f = device.Tick(2000, 1e-3);
+  f = device.Tick(2000);
   EXPECT_EQ(backend.last[0], 3000);
   EXPECT_EQ(f.rx_lost, 3U);
   EXPECT_EQ(f.rx_corrupt, 1U);
 }
 
-class ModelBackendTest : public ::testing::Test {
- protected:
-  ModelBackend Make(bool noise) {
-    const StackConfig& c = test::Config();
-    ModelBackendOptions o;
-    o.noise = noise;
-    return ModelBackend(c.platform, c.actuators, c.sensors, c.hw_bridge, c.home_pose,
-                        Vector6d::Zero(), o);
-  }
-};
+TEST(DeviceWatchdog, CommandActsFromItsArrivalAndExpiresOnTime) {
+  // The physics is split at every event: a command drives the legs from the
+  // instant it arrives, and the watchdog cuts it at exactly rx + watchdog_us.
+  RecordingBackend backend;
+  DeviceEmulator device(&backend);
+  device.Tick(1000);
+  device.OnCommandFrame(Command(1, 4000, 2500), 1300);
+  device.Tick(2000);
+  device.OnCommandFrame(Command(2, 6000, 2500), 2250);
+  device.Tick(3000);
+  device.Tick(5000);
+  const SensorFrame f = device.Tick(6000);
+  ASSERT_EQ(backend.segments.size(), 7U);
+  const auto expect = [&](std::size_t i, int16_t drive, double dt_s) {
+    EXPECT_EQ(backend.segments[i].drive[0], drive) << "segment " << i;
+    EXPECT_NEAR(backend.segments[i].dt_s, dt_s, 1e-12) << "segment " << i;
+  };
+  expect(0, 0, 300e-6);      // 1000 .. 1300: nothing yet
+  expect(1, 4000, 700e-6);   // 1300 .. 2000
+  expect(2, 4000, 250e-6);   // 2000 .. 2250
+  expect(3, 6000, 750e-6);   // 2250 .. 3000
+  expect(4, 6000, 1750e-6);  // 3000 .. 4750: the watchdog expires at 2250 + 2500
+  expect(5, 0, 250e-6);      // 4750 .. 5000
+  expect(6, 0, 1000e-6);     // 5000 .. 6000
+  EXPECT_NE(f.status & kStatusWatchdog, 0);
+  EXPECT_EQ(f.device_time_us, 6000U);
+}
 
-TEST_F(ModelBackendTest, ZeroDriveHoldsThePose) {
-  ModelBackend backend = Make(false);
-  const Vector6d q0 = backend.q();
-  for (int k = 0; k < 200; ++k) backend.Step(DriveArray{}, 1e-3);
-  EXPECT_LT((backend.q() - q0).norm(), 1e-12);
-  const RawReadings raw = backend.Sample();
+std::unique_ptr<PlantBackend> MakeBackend(bool noise) {
+  const StackConfig& c = test::Config();
+  PlantBackendOptions o;
+  o.noise = noise;
+  return std::make_unique<PlantBackend>(c, c.home_pose, Vector6d::Zero(), o);
+}
+
+TEST(PlantBackend, UnpoweredLegsHoldThePose) {
+  // Zero drive: the P-16P lead screws hold every leg (plant_sim's power-off
+  // lock), so the platform stays put under its weight.
+  std::unique_ptr<PlantBackend> backend = MakeBackend(false);
   const ImuScale imu(test::Config().hw_bridge);
-  EXPECT_NEAR(imu.AccelMps2(raw.accel_raw).z(), test::Config().platform.gravity_mps2, 0.01);
+  const double g = test::Config().platform.gravity_mps2;
+  // From the first sample at power-on the locks carry the weight: +g, not free fall.
+  EXPECT_NEAR(imu.AccelMps2(backend->Sample().accel_raw).z(), g, 0.01);
+  EXPECT_LT((backend->q() - test::Config().home_pose).norm(), 1e-4);  // the sag
+  const Vector6d q0 = backend->q();
+  for (int k = 0; k < 200; ++k) backend->Step(DriveArray{}, 1e-3);
+  EXPECT_TRUE(backend->actuators_off());
+  EXPECT_LT((backend->q() - q0).head<3>().norm(), 1e-4);
+  const RawReadings raw = backend->Sample();
+  EXPECT_NEAR(imu.AccelMps2(raw.accel_raw).z(), g, 0.01);
   EXPECT_EQ(raw.status, 0);
 }
 
-TEST_F(ModelBackendTest, GravityCompensationThroughTheBridgeMapHoldsStill) {
+TEST(PlantBackend, GravityCompensationThroughTheBridgeMapHoldsStill) {
   // The bridge's map forward, the emulator's inverse: the gravity-compensating
   // forces keep the platform nearly still (only drive quantisation remains).
   const StackConfig& c = test::Config();
-  ModelBackend backend = Make(false);
+  std::unique_ptr<PlantBackend> backend = MakeBackend(false);
   const DriveMap map(c.hw_bridge, c.actuators.force_limit_n);
   const DynamicsTerms terms = EvaluateDynamics(c.platform, c.home_pose, Vector6d::Zero());
   const Vector6d f_hold = InverseDynamics(terms, Vector6d::Zero());
   const DriveArray drive = map.ForceToDrive(f_hold).drive;
-  for (int k = 0; k < 500; ++k) backend.Step(drive, 1e-3);
-  EXPECT_LT((backend.q() - c.home_pose).head<3>().norm(), 1e-3);
-  EXPECT_LT(backend.qd().norm(), 1e-2);
+  for (int k = 0; k < 500; ++k) backend->Step(drive, 1e-3);
+  EXPECT_FALSE(backend->actuators_off());
+  EXPECT_LT((backend->force_cmd_n() - f_hold).cwiseAbs().maxCoeff(), 2e-3);
+  EXPECT_LT((backend->q() - c.home_pose).head<3>().norm(), 1e-3);
+  EXPECT_LT(backend->qd().norm(), 1e-2);
   // ...and extra force on every leg raises it.
   DriveArray up = map.ForceToDrive(f_hold + Vector6d::Constant(5.0)).drive;
-  for (int k = 0; k < 200; ++k) backend.Step(up, 1e-3);
-  EXPECT_GT(backend.q()(2), c.home_pose(2) + 1e-3);
+  for (int k = 0; k < 200; ++k) backend->Step(up, 1e-3);
+  EXPECT_GT(backend->q()(2), c.home_pose(2) + 1e-3);
 }
 
-TEST_F(ModelBackendTest, SamplesDecodeBackToTheTrueLegLengths) {
+TEST(PlantBackend, SamplesDecodeBackToTheTrueLegLengths) {
   const StackConfig& c = test::Config();
-  ModelBackend backend = Make(true);
+  std::unique_ptr<PlantBackend> backend = MakeBackend(true);
   const LegCalibration cal(c.hw_bridge, c.platform.leg_min_length_m,
                            c.platform.leg_max_length_m - c.platform.leg_min_length_m);
-  const Vector6d truth = InverseKinematics(c.platform, backend.q());
-  const RawReadings raw = backend.Sample();
+  const Vector6d truth = InverseKinematics(c.platform, backend->q());
+  const RawReadings raw = backend->Sample();
   const double count_m = (c.platform.leg_max_length_m - c.platform.leg_min_length_m) /
                          (c.hw_bridge.adc_extended(0) - c.hw_bridge.adc_retracted(0));
+  // The simulator's ADC step, then the device's count, then the pot noise.
+  const double tolerance_m = 0.5 * LegAdcResolution(c.sensors, c.actuators) + 0.5 * count_m +
+                             5 * c.sensors.leg_pot_noise_std_m;
   for (int i = 0; i < 6; ++i) {
-    EXPECT_NEAR(cal.LengthM(i, raw.adc[static_cast<std::size_t>(i)]), truth(i),
-                count_m + 5 * c.sensors.leg_pot_noise_std_m);
+    EXPECT_NEAR(cal.LengthM(i, raw.adc[static_cast<std::size_t>(i)]), truth(i), tolerance_m);
   }
+}
+
+// The acceptance of the emulator: bridge + emulator, without transports, in
+// a closed loop, against plant_sim's Plant and SensorModel driven with the
+// same forces (as plant_sim in lockstep: the force answering sample k acts
+// from t_k). Both sides must agree up to the drive and ADC quantisation.
+TEST(PlantBackend, BridgePlusEmulatorEqualsPlantSim) {
+  const StackConfig& c = test::Config();
+  constexpr int kTicks = 3000;  // 3 s at 1 kHz
+  constexpr int64_t kPeriodUs = 1000;
+  constexpr uint64_t kDeviceEpochUs = 7'000'000;
+  constexpr int64_t kHostEpochUs = 1'700'000'000'000'000;
+  constexpr int64_t kLinkDelayUs = 40;
+
+  // Device + bridge.
+  PlantBackend backend(c, c.home_pose, Vector6d::Zero());
+  DeviceEmulator device(&backend);
+  HwBridge bridge(c.hw_bridge, c.platform.leg_min_length_m,
+                  c.platform.leg_max_length_m - c.platform.leg_min_length_m,
+                  c.actuators.force_limit_n);
+  // plant_sim's library, as its node uses it (legs locked until the first command).
+  OdeOptions ode;
+  ode.rel_tol = c.plant_sim.rel_tol;
+  ode.abs_tol = c.plant_sim.abs_tol;
+  Plant plant(PlantModel{c.platform, c.actuators}, ode);
+  plant.Reset(0.0, c.home_pose, Vector6d::Zero());
+  plant.SetActuatorsOff(true);
+  plant.Advance(PlantBackendOptions{}.power_on_settle_s);  // as the device at power-on
+  SensorModel sensors(c.sensors, c.actuators, c.platform.gravity_mps2);
+
+  const DynamicsTerms home = EvaluateDynamics(c.platform, c.home_pose, Vector6d::Zero());
+  const Vector6d f_hold = InverseDynamics(home, Vector6d::Zero());
+  const Vector6d l_home = home.leg_length_m;
+  // A leg-space PD on each side's own ground truth, tracking 4 mm of leg
+  // motion at 0.5 Hz: forces stay well outside the bridge's dead zone.
+  const auto control = [&](const Vector6d& q, const Vector6d& qd, double t_s) {
+    const DynamicsTerms terms = EvaluateDynamics(c.platform, q, qd);
+    const Vector6d l_ref =
+        l_home + Vector6d::LinSpaced(-1.0, 1.0) * 4e-3 * std::sin(2.0 * M_PI * 0.5 * t_s);
+    return Vector6d(f_hold + 300.0 * (l_ref - terms.leg_length_m) -
+                    30.0 * (terms.H.transpose() * qd));
+  };
+
+  const double count_m =
+      c.actuators.stroke_m / (c.hw_bridge.adc_extended(0) - c.hw_bridge.adc_retracted(0));
+  const double adc_step_m = LegAdcResolution(c.sensors, c.actuators);
+  double max_dq = 0.0, max_dqd = 0.0, max_drate = 0.0, max_dgyro = 0.0, max_daccel = 0.0,
+         min_force = 1e9;
+  long legs_within_a_count = 0, legs_total = 0;
+  double max_dleg = 0.0;
+  int64_t last_utime = 0;
+  for (int k = 0; k < kTicks; ++k) {
+    const double t_s = k * kPeriodUs * 1e-6;
+    const uint64_t device_us = kDeviceEpochUs + static_cast<uint64_t>(k * kPeriodUs);
+    // Sample k on both sides.
+    const SensorFrame frame = device.Tick(device_us);
+    SensorSample sample;
+    ASSERT_TRUE(bridge.OnSensorFrame(
+        frame, kHostEpochUs + static_cast<int64_t>(device_us) + kLinkDelayUs, &sample));
+    if (k > 0) {
+      ASSERT_EQ(sample.utime - last_utime, kPeriodUs);
+    }
+    last_utime = sample.utime;
+    const PlantRates& rates = plant.EvaluateRates();
+    const SensorReading reading =
+        sensors.Sample(plant.q(), plant.qd(), rates.x_dot.segment<6>(6), rates.terms.leg_length_m);
+    max_dq = std::max(max_dq, (backend.q() - plant.q()).cwiseAbs().maxCoeff());
+    const Vector6d dqd = backend.qd() - plant.qd();
+    max_dqd = std::max(max_dqd, dqd.head<3>().cwiseAbs().maxCoeff());
+    max_drate = std::max(max_drate, dqd.tail<3>().cwiseAbs().maxCoeff());
+    for (int i = 0; i < 6; ++i) {
+      const double d = std::abs(sample.leg_length_m(i) - reading.leg_length_m(i));
+      max_dleg = std::max(max_dleg, d);
+      legs_within_a_count += d <= count_m ? 1 : 0;
+      ++legs_total;
+    }
+    max_dgyro = std::max(max_dgyro, (sample.gyro_radps - reading.gyro_radps).cwiseAbs().maxCoeff());
+    max_daccel =
+        std::max(max_daccel, (sample.accel_mps2 - reading.accel_mps2).cwiseAbs().maxCoeff());
+
+    // The force answering sample k, on both sides from t_k.
+    const Vector6d f_emu = control(backend.q(), backend.qd(), t_s);
+    const Vector6d f_sim = control(plant.q(), plant.qd(), t_s);
+    min_force = std::min(min_force, f_emu.cwiseAbs().minCoeff());
+    ASSERT_EQ(bridge.OnForceCommand(sample.utime, f_emu), CommandVerdict::kAccepted);
+    std::array<uint8_t, kMaxFrameSize> buffer{};
+    const std::size_t size = bridge.BuildCommandFrame(sample.utime, buffer.data());
+    DecodedFrame command;
+    ASSERT_EQ(DecodeDatagram(buffer.data(), size, &command), DecodeStatus::kOk);
+    device.OnCommandFrame(command.command, device_us);
+    plant.SetActuatorsOff(false);
+    plant.SetForceCommand(f_sim);
+    plant.Advance(kPeriodUs * 1e-6);
+  }
+  std::printf(
+      "[bridge+emulator vs plant_sim] 3 s: max |dq| %.2e, max |dqd| %.2e m/s %.2e rad/s, legs "
+      "within a count "
+      "%.4f (max %.2e m), max |dgyro| %.2e rad/s, max |daccel| %.2e m/s^2, min |F| %.2f N\n",
+      max_dq, max_dqd, max_drate, static_cast<double>(legs_within_a_count) / legs_total, max_dleg,
+      max_dgyro, max_daccel, min_force);
+  EXPECT_GT(min_force, c.hw_bridge.force_deadzone_n);  // the comparison stays outside the dead zone
+  // Drive quantisation (1 count = 3.3 mN) against the PD's 300 N/m: microns;
+  // on the light rotations (4e-3 kg m^2) a few 1e-4 rad/s.
+  EXPECT_LT(max_dq, 2e-5);
+  EXPECT_LT(max_dqd, 1e-4);
+  EXPECT_LT(max_drate, 5e-4);
+  // Same seed, same draws: the readings differ by the device's count and
+  // LSB roundings only, and a leg's 10-bit code flips now and then where
+  // the microns of trajectory difference straddle a code boundary.
+  EXPECT_GT(static_cast<double>(legs_within_a_count) / legs_total, 0.99);
+  EXPECT_LE(max_dleg, adc_step_m + count_m);
+  // Half an LSB plus the rate difference above; both far below the noise.
+  EXPECT_LE(max_dgyro, 0.5 * c.hw_bridge.gyro_radps_per_lsb + 5e-4);
+  EXPECT_LT(max_dgyro, c.sensors.gyro_noise_std_radps);
+  EXPECT_LE(max_daccel, 0.5 * c.hw_bridge.accel_mps2_per_lsb + 0.01);
+  EXPECT_LT(max_daccel, c.sensors.accel_noise_std_mps2);
 }
 
 }  // namespace

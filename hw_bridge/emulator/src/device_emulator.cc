@@ -1,5 +1,7 @@
 #include "stewart/hw_emulator/device_emulator.h"
 
+#include <algorithm>
+
 namespace stewart::hw {
 
 void DeviceEmulator::OnCommandFrame(const CommandFrame& frame, uint64_t now_us) {
@@ -8,39 +10,66 @@ void DeviceEmulator::OnCommandFrame(const CommandFrame& frame, uint64_t now_us) 
     if (gap <= 0) return;  // duplicate or reordered: the newer one is in force
     rx_lost_ += static_cast<uint32_t>(gap - 1);
   }
+  AdvanceTo(now_us);
   have_command_ = true;
   command_ = frame;
-  command_rx_us_ = now_us;
+  // A frame stamped before the physics' time (it waited in the receive
+  // queue while a sample was taken) acts from now on, never in the past.
+  command_rx_us_ = std::max(now_us, physics_us_);
 }
 
-SensorFrame DeviceEmulator::Tick(uint64_t now_us, double dt_s) {
-  status_ = 0;
+DriveArray DeviceEmulator::DriveFrom(uint64_t t_us, uint16_t* status) const {
+  *status = 0;
   if (!have_command_) {
-    status_ |= kStatusActuatorsOff;
-  } else if (now_us - command_rx_us_ > command_.watchdog_us) {
-    status_ |= kStatusWatchdog;
+    *status = kStatusActuatorsOff;
+  } else if (t_us - command_rx_us_ >= command_.watchdog_us) {
+    // In force up to and including rx + watchdog_us, zero after it.
+    *status = kStatusWatchdog;
   } else if ((command_.flags & kCommandEnable) == 0) {
-    status_ |= kStatusActuatorsOff;
+    *status = kStatusActuatorsOff;
   }
-  if (status_ == 0) {
-    applied_drive_ = command_.drive;
-  } else {
-    applied_drive_.fill(0);
+  return *status == 0 ? command_.drive : DriveArray{};
+}
+
+void DeviceEmulator::AdvanceTo(uint64_t t_us) {
+  if (!started_) {
+    started_ = true;
+    physics_us_ = t_us;
+    return;
   }
-  backend_->Step(applied_drive_, dt_s);
+  while (physics_us_ < t_us) {
+    uint16_t status = 0;
+    applied_drive_ = DriveFrom(physics_us_, &status);
+    uint64_t end_us = t_us;
+    if (status == 0) end_us = std::min(end_us, command_rx_us_ + command_.watchdog_us);
+    backend_->Step(applied_drive_, static_cast<double>(end_us - physics_us_) * 1e-6);
+    physics_us_ = end_us;
+  }
+}
+
+SensorFrame DeviceEmulator::Tick(uint64_t now_us) {
+  AdvanceTo(now_us);
+  uint16_t status = 0;
+  if (!have_command_) {
+    status = kStatusActuatorsOff;
+  } else if (physics_us_ - command_rx_us_ > command_.watchdog_us) {
+    status = kStatusWatchdog;
+  } else if ((command_.flags & kCommandEnable) == 0) {
+    status = kStatusActuatorsOff;
+  }
   const RawReadings raw = backend_->Sample();
 
   SensorFrame frame;
   frame.seq = next_seq_++;
-  frame.device_time_us = now_us;
+  frame.device_time_us = physics_us_;
   frame.adc = raw.adc;
   frame.gyro_raw = raw.gyro_raw;
   frame.accel_raw = raw.accel_raw;
-  frame.status = static_cast<uint16_t>(status_ | raw.status);
+  frame.status = static_cast<uint16_t>(status | raw.status);
   frame.leg_fault_mask = raw.leg_fault_mask;
   if (raw.leg_fault_mask != 0) frame.status |= kStatusLegFault;
   frame.last_command_seq = have_command_ ? command_.seq : 0;
-  frame.command_age_us = have_command_ ? static_cast<uint32_t>(now_us - command_rx_us_) : 0;
+  frame.command_age_us = have_command_ ? static_cast<uint32_t>(physics_us_ - command_rx_us_) : 0;
   frame.applied_drive = applied_drive_;
   frame.rx_corrupt = rx_corrupt_;
   frame.rx_lost = rx_lost_;

@@ -56,6 +56,8 @@ struct BridgeCounters {
   uint64_t zero_drive_frames = 0;  ///< frames sent with zero drive for a DriveReason != kCommand
   uint64_t force_clamped = 0;      ///< legs clamped to the force limit (frames x legs)
   uint64_t duty_clamped = 0;
+  uint64_t force_deadzoned =
+      0;  ///< legs whose non-zero force fell in the dead zone (frames x legs)
   uint64_t device_rx_corrupt = 0;  ///< the device's own counters (latest)
   uint64_t device_rx_lost = 0;
   WindowStats rtt_us;    ///< command round trip, per health window

@@ -14,6 +14,9 @@ struct DriveResult {
   DriveArray drive{};
   uint8_t force_clamped_mask = 0;  ///< bit i: |F_i| exceeded actuators.force_limit_n
   uint8_t duty_clamped_mask = 0;   ///< bit i: |duty_i| exceeded hw_bridge.max_duty
+  /// bit i: 0 < |F_i| < force_deadzone_n, so a commanded force was not applied
+  /// (zero drive). The stack assumes the commanded force acts: docs/hardware.md.
+  uint8_t deadzone_mask = 0;
 };
 
 /// For each leg, with F_c = clamp(F, +-force_limit_n):

@@ -1,8 +1,8 @@
 #pragma once
 // What the emulated device's electronics see: drive commands in, raw
-// readings out. The physics behind it is a backend, so the model-based one
-// here can be swapped for plant_sim's library without touching the device
-// logic (watchdog, framing, transports).
+// readings out. The physics behind it is a backend (PlantBackend: plant_sim's
+// library), kept apart from the device logic (watchdog, framing, transports)
+// so either can change alone and tests can record what the device applied.
 #include <array>
 #include <cstdint>
 
