@@ -26,11 +26,13 @@ usage: tools/launch.sh [options]
   --out DIR             run folder (default: runs/<date>-<scenario>)
   --no-build            use the build as it is (skip tools/setup.sh; tests use this)
   --lcm-logger          record with the packaged lcm-logger instead of stewart_logger
+  --rt-priority P       SCHED_FIFO priority of plant, estimator, controller and safety
+                        (default: 50 in real time when permitted, else 0 = normal scheduling)
 USAGE
 }
 
 PLANT=sim MODE="" SCENARIO=paper CONFIG="$ROOT/config/platform.yaml" VARIANT="" DURATION=""
-LOG="" DO_LOG=1 DO_REPORT=1 SPY=0 URL="" OUT="" EMULATOR=0 BUILD_FIRST=1 LCM_LOGGER=0
+LOG="" DO_LOG=1 DO_REPORT=1 SPY=0 URL="" OUT="" EMULATOR=0 BUILD_FIRST=1 LCM_LOGGER=0 RT_PRIORITY=
 ARGS="$*"
 while (($#)); do
   case "$1" in
@@ -50,6 +52,7 @@ while (($#)); do
     --out) OUT=$(realpath -m "$2"); shift ;;
     --no-build) BUILD_FIRST=0 ;;
     --lcm-logger) LCM_LOGGER=1 ;;
+    --rt-priority) RT_PRIORITY=$2; shift ;;
     -h|--help) usage; exit 0 ;;
     *) echo "launch: unknown option '$1'" >&2; usage >&2; exit 2 ;;
   esac
@@ -59,6 +62,19 @@ done
 [[ -n $MODE ]] || { [[ $PLANT == sim ]] && MODE=lockstep || MODE=realtime; }
 if [[ $PLANT == hw && $MODE == lockstep ]]; then
   echo "launch: the real device cannot step in lockstep; use --realtime" >&2; exit 2
+fi
+# The loop's processes preempt everything else (logger, monitor, builds) in
+# real time: a control tick must not wait behind a recorder's disk write.
+if [[ -z $RT_PRIORITY ]]; then
+  RT_PRIORITY=0
+  if [[ $MODE == realtime ]] && chrt -f 1 true 2>/dev/null; then RT_PRIORITY=50; fi
+fi
+[[ $RT_PRIORITY =~ ^[0-9]+$ && $RT_PRIORITY -le 99 ]] || { echo "launch: --rt-priority 0..99" >&2; exit 2; }
+RT=()
+if ((RT_PRIORITY > 0)); then
+  chrt -f "$RT_PRIORITY" true 2>/dev/null ||
+    { echo "launch: SCHED_FIFO $RT_PRIORITY not permitted (root or CAP_SYS_NICE / rtprio limit)" >&2; exit 2; }
+  RT=(chrt -f "$RT_PRIORITY")
 fi
 
 ((BUILD_FIRST)) && tools/setup.sh >/dev/null
@@ -95,6 +111,7 @@ else cp "$ROOT/config/scenarios/$SCENARIO.yaml" "$OUT/scenario.yaml"; fi
   echo "scenario: $SCENARIO"
   echo "duration_s: $DURATION"
   echo "variant: ${VARIANT:-from config}"
+  echo "rt_priority: $RT_PRIORITY"
   echo "lcm_url: $URL"
   echo "command: tools/launch.sh $ARGS"
 } > "$OUT/run.yaml"
@@ -102,6 +119,7 @@ else cp "$ROOT/config/scenarios/$SCENARIO.yaml" "$OUT/scenario.yaml"; fi
 echo "== Stewart stack: $PLANT, $MODE, scenario '$SCENARIO' ($DURATION s) =="
 echo "   run folder: $OUT"
 echo "   LCM URL:    $URL"
+((RT_PRIORITY > 0)) && echo "   scheduling: SCHED_FIFO $RT_PRIORITY for the loop's processes"
 echo "   process logs: $OUT/<process>.log"
 
 PIDS=() NAMES=()
@@ -146,19 +164,19 @@ if ((SPY)); then start lcm-spy "$ROOT/tools/lcm-spy" --lcm-url="$URL"; fi
 
 SAFETY_ARGS=("${COMMON[@]}")
 [[ -z $VARIANT ]] || SAFETY_ARGS+=(--variant "$VARIANT")
-start safety "$SAFETY" "${SAFETY_ARGS[@]}"
-start controller "$CONTROLLER" "${COMMON[@]}" --scenario "$SCENARIO"
-start estimator "$ESTIMATOR" "${COMMON[@]}"
+start safety "${RT[@]}" "$SAFETY" "${SAFETY_ARGS[@]}"
+start controller "${RT[@]}" "$CONTROLLER" "${COMMON[@]}" --scenario "$SCENARIO"
+start estimator "${RT[@]}" "$ESTIMATOR" "${COMMON[@]}"
 "$MONITOR" "${COMMON[@]}" --wait-for safety,controller,estimator --timeout 15 ||
   { echo "launch: the stack did not come up" >&2; for n in safety controller estimator; do tail -n 5 "$OUT/$n.log" >&2; done; stop_all; exit 1; }
 
 if [[ $PLANT == sim ]]; then
-  start plant_sim "$PLANT_SIM" "${COMMON[@]}" --mode "$MODE" --duration "$DURATION"
+  start plant_sim "${RT[@]}" "$PLANT_SIM" "${COMMON[@]}" --mode "$MODE" --duration "$DURATION"
   PLANT_NAME=plant_sim
 else
   # The emulator publishes its ground truth (evaluation only) on the run's URL.
-  if ((EMULATOR)); then start hw_emulator "$(bin hw_emulator)" "${COMMON[@]}"; fi
-  start hw_bridge "$(bin hw_bridge)" "${COMMON[@]}"
+  if ((EMULATOR)); then start hw_emulator "${RT[@]}" "$(bin hw_emulator)" "${COMMON[@]}"; fi
+  start hw_bridge "${RT[@]}" "$(bin hw_bridge)" "${COMMON[@]}"
   PLANT_NAME=hw_bridge
 fi
 start monitor "$MONITOR" "${COMMON[@]}" --progress-of "$DURATION"

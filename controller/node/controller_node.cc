@@ -11,9 +11,6 @@ namespace stewart {
 namespace {
 
 constexpr int kPollMs = 50;
-// Bursts happen when a log is replayed or the estimator catches up; a
-// dropped state would silently skip a control step.
-constexpr int kQueueCapacity = 1000;
 
 Setpoint FromMessage(const setpoint_t& msg) {
   Setpoint s;
@@ -29,16 +26,15 @@ ControllerNode::ControllerNode(const StackConfig& config, std::optional<Scenario
                                bool exit_at_end)
     : config_(config),
       lcm_(MakeLcm(config.lcm.url)),
+      receiver_(config.lcm.url),
       controller_(config.platform, config.controller, config.home_pose, std::move(scenario)),
       health_("controller", config.lcm.channels.health, config.lcm.health_rate_hz),
       exit_at_end_(exit_at_end) {
-  lcm_->subscribe(config_.lcm.channels.state_estimate, &ControllerNode::OnState, this)
-      ->setQueueCapacity(kQueueCapacity);
+  receiver_.Subscribe(config_.lcm.channels.state_estimate, &ControllerNode::OnState, this);
   // A scenario's setpoints are echoed on the setpoint channel: listening to
   // it as well would feed the controller its own output.
   if (!controller_.following_scenario()) {
-    lcm_->subscribe(config_.lcm.channels.setpoint, &ControllerNode::OnSetpoint, this)
-        ->setQueueCapacity(kQueueCapacity);
+    receiver_.Subscribe(config_.lcm.channels.setpoint, &ControllerNode::OnSetpoint, this);
   }
 }
 
@@ -92,7 +88,7 @@ int ControllerNode::Run() {
                controller_.following_scenario() ? " + " + ch.setpoint
                                                 : " (live setpoints on " + ch.setpoint + ")",
                config_.lcm.url);
-  return RunNodeLoop("controller", lcm_.get(), &health_, kPollMs, [this] {
+  return RunNodeLoop("controller", lcm_.get(), &receiver_, &health_, kPollMs, [this] {
     if (!exit_at_end_ || !controller_.scenario_finished()) return false;
     spdlog::info("controller: scenario '{}' finished", controller_.scenario()->name());
     return true;

@@ -9,6 +9,7 @@
 #include "stewart/controller/controller.h"
 #include "stewart/force_command_t.hpp"
 #include "stewart/node/health_reporter.h"
+#include "stewart/node/lcm_receiver.h"
 #include "stewart/setpoint_t.hpp"
 #include "stewart/state_t.hpp"
 
@@ -28,6 +29,7 @@ class ControllerNode {
  private:
   StackConfig config_;
   std::unique_ptr<lcm::LCM> lcm_;
+  LcmReceiver receiver_;
   Controller controller_;
   HealthReporter health_;
   bool exit_at_end_;

@@ -8,27 +8,20 @@
 #include "stewart/node/stop_signal.h"
 
 namespace stewart {
-namespace {
-// Bursts (a replayed log, a stalled scheduler) must not drop samples silently.
-constexpr int kQueueCapacity = 1000;
-}  // namespace
-
 EstimatorNode::EstimatorNode(const StackConfig& config, lcm::LCM* lcm, bool perfect_state)
     : config_(config),
       lcm_(lcm),
+      receiver_(config.lcm.url),
       perfect_state_(perfect_state),
       ekf_(config.platform, config.actuators, config.sensors, config.estimator, config.home_pose),
       health_("estimator", config.lcm.channels.health, config.lcm.health_rate_hz) {
   if (perfect_state_) {
     spdlog::warn("estimator: PERFECT STATE mode: republishing {} as {} (testing only)",
                  config_.lcm.channels.state_truth, config_.lcm.channels.state_estimate);
-    lcm_->subscribe(config_.lcm.channels.state_truth, &EstimatorNode::OnTruth, this)
-        ->setQueueCapacity(kQueueCapacity);
+    receiver_.Subscribe(config_.lcm.channels.state_truth, &EstimatorNode::OnTruth, this);
   } else {
-    lcm_->subscribe(config_.lcm.channels.sensors, &EstimatorNode::OnSensor, this)
-        ->setQueueCapacity(kQueueCapacity);
-    lcm_->subscribe(config_.lcm.channels.command_safe, &EstimatorNode::OnCommand, this)
-        ->setQueueCapacity(kQueueCapacity);
+    receiver_.Subscribe(config_.lcm.channels.sensors, &EstimatorNode::OnSensor, this);
+    receiver_.Subscribe(config_.lcm.channels.command_safe, &EstimatorNode::OnCommand, this);
   }
 }
 
@@ -94,6 +87,6 @@ void EstimatorNode::Publish(const state_t& msg) {
   health_.MaybePublish(lcm_);
 }
 
-int EstimatorNode::Run() { return RunNodeLoop("estimator", lcm_, &health_, 100); }
+int EstimatorNode::Run() { return RunNodeLoop("estimator", lcm_, &receiver_, &health_, 100); }
 
 }  // namespace stewart

@@ -10,6 +10,7 @@
 #include "stewart/estimator/ekf.h"
 #include "stewart/force_command_t.hpp"
 #include "stewart/node/health_reporter.h"
+#include "stewart/node/lcm_receiver.h"
 #include "stewart/sensor_t.hpp"
 #include "stewart/state_t.hpp"
 
@@ -34,6 +35,7 @@ class EstimatorNode {
 
   StackConfig config_;
   lcm::LCM* lcm_;
+  LcmReceiver receiver_;
   bool perfect_state_;
   Ekf ekf_;
   HealthReporter health_;

@@ -15,6 +15,7 @@
 #include "stewart/node/eigen_msg.h"
 #include "stewart/node/health_reporter.h"
 #include "stewart/node/lcm_handle.h"
+#include "stewart/node/lcm_receiver.h"
 #include "stewart/node/node_options.h"
 #include "stewart/node/stop_signal.h"
 #include "stewart/sensor_t.hpp"
@@ -27,23 +28,22 @@ class BridgeNode {
   BridgeNode(const StackConfig& config, lcm::LCM* lcm, hw::Transport* transport)
       : config_(config),
         lcm_(lcm),
+        receiver_(config.lcm.url),
         transport_(transport),
         bridge_(config.hw_bridge, config.platform.leg_min_length_m,
                 config.platform.leg_max_length_m - config.platform.leg_min_length_m,
                 config.actuators.force_limit_n),
         health_("hw_bridge", config.lcm.channels.health, config.lcm.health_rate_hz) {
-    lcm::Subscription* sub =
-        lcm_->subscribe(config.lcm.channels.command_safe, &BridgeNode::OnCommand, this);
-    sub->setQueueCapacity(200);
+    receiver_.Subscribe(config.lcm.channels.command_safe, &BridgeNode::OnCommand, this);
   }
 
   void Run() {
     std::array<pollfd, 2> fds{pollfd{transport_->fd(), POLLIN, 0},
-                              pollfd{lcm_->getFileno(), POLLIN, 0}};
+                              pollfd{receiver_.fd(), POLLIN, 0}};
     while (!StopRequested()) {
       const int ready = poll(fds.data(), fds.size(), 5);
       if (ready > 0 && (fds[0].revents & (POLLIN | POLLERR | POLLHUP)) != 0) ReadDevice();
-      if (ready > 0 && (fds[1].revents & POLLIN) != 0) lcm_->handleTimeout(0);
+      if (ready > 0 && (fds[1].revents & POLLIN) != 0) receiver_.HandleTimeout(0);
       UpdateHealth();
     }
     health_.SetState(health_t::STATE_STOPPED);
@@ -173,6 +173,7 @@ class BridgeNode {
 
   const StackConfig& config_;
   lcm::LCM* lcm_;
+  LcmReceiver receiver_;
   hw::Transport* transport_;
   hw::HwBridge bridge_;
   HealthReporter health_;

@@ -6,11 +6,11 @@
 
 namespace stewart {
 
-int RunNodeLoop(const std::string& name, lcm::LCM* lcm, HealthReporter* health, int poll_ms,
-                const std::function<bool()>& done) {
+int RunNodeLoop(const std::string& name, lcm::LCM* lcm, LcmReceiver* receiver,
+                HealthReporter* health, int poll_ms, const std::function<bool()>& done) {
   health->MaybePublish(lcm, true);
   while (!StopRequested()) {
-    if (lcm->handleTimeout(poll_ms) < 0 && !StopRequested()) {
+    if (receiver->HandleTimeout(poll_ms) < 0 && !StopRequested()) {
       spdlog::error("{}: LCM receive failed", name);
       health->SetState(health_t::STATE_FAULT);
       health->MaybePublish(lcm, true);

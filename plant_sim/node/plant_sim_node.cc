@@ -36,6 +36,7 @@ PlantSimNode::PlantSimNode(const StackConfig& config, const PlantSimOptions& opt
     : config_(config),
       options_(options),
       lcm_(MakeLcm(config.lcm.url)),
+      receiver_(config.lcm.url),
       plant_(PlantModel{config.platform, config.actuators}, OdeOptionsFrom(config.plant_sim)),
       sensors_(config.sensors, config.actuators, config.platform.gravity_mps2),
       health_("plant_sim", config.lcm.channels.health, config.lcm.health_rate_hz),
@@ -44,9 +45,7 @@ PlantSimNode::PlantSimNode(const StackConfig& config, const PlantSimOptions& opt
   period_us_ = std::llround(1e6 / config.sensors.rate_hz);
   if (period_us_ <= 0) throw std::invalid_argument("sensors.rate_hz is too high (period < 1 us)");
   plant_.Reset(0.0, config.plant_sim.initial_pose, config.plant_sim.initial_velocity);
-  lcm::Subscription* sub =
-      lcm_->subscribe(config.lcm.channels.command_safe, &PlantSimNode::HandleCommand, this);
-  sub->setQueueCapacity(1000);  // a burst must never be dropped silently
+  receiver_.Subscribe(config.lcm.channels.command_safe, &PlantSimNode::HandleCommand, this);
 }
 
 int PlantSimNode::Run() {
@@ -190,13 +189,13 @@ int PlantSimNode::RunRealTime() {
       const Clock::duration left = deadline - Clock::now();
       if (left <= Clock::duration::zero()) break;
       if (left < std::chrono::milliseconds(1)) {
-        lcm_->handleTimeout(0);
+        receiver_.HandleTimeout(0);
         std::this_thread::sleep_until(deadline);
         break;
       }
-      lcm_->handleTimeout(TimeoutMs(left));
+      receiver_.HandleTimeout(TimeoutMs(left));
     }
-    while (lcm_->handleTimeout(0) > 0) {
+    while (receiver_.HandleTimeout(0) > 0) {
     }
     if (StopRequested()) break;
     // Real-time bookkeeping (docs/simulation.md, "Real-time figures"):
@@ -260,7 +259,7 @@ int PlantSimNode::RunLockstep() {
         last_sent = now;
       }
       const Clock::duration remaining = timeout - (now - waiting_since);
-      lcm_->handleTimeout(TimeoutMs(std::min<Clock::duration>(remaining, resend_every)));
+      receiver_.HandleTimeout(TimeoutMs(std::min<Clock::duration>(remaining, resend_every)));
       health_.MaybePublish(lcm_.get());
     }
     plant_.SetForceCommand(answer_force_n_);

@@ -9,6 +9,7 @@
 #include "stewart/config/stack_config.h"
 #include "stewart/force_command_t.hpp"
 #include "stewart/node/health_reporter.h"
+#include "stewart/node/lcm_receiver.h"
 #include "stewart/plant_sim/command_policy.h"
 #include "stewart/plant_sim/plant.h"
 #include "stewart/plant_sim/sensor_model.h"
@@ -47,6 +48,7 @@ class PlantSimNode {
   StackConfig config_;
   PlantSimOptions options_;
   std::unique_ptr<lcm::LCM> lcm_;
+  LcmReceiver receiver_;
   Plant plant_;
   SensorModel sensors_;
   HealthReporter health_;

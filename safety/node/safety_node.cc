@@ -5,24 +5,19 @@
 #include "stewart/safety/diagnostics_lcm.h"
 
 namespace stewart {
-namespace {
-// Replayed logs and catching-up estimators deliver bursts; LCM would drop
-// the newest silently beyond its default 30.
-constexpr int kQueueCapacity = 1000;
-}  // namespace
-
 SafetyNode::SafetyNode(const StackConfig& config, lcm::LCM* lcm,
                        safety::ReferenceQpSolver* reference)
     : config_(config),
       lcm_(lcm),
+      receiver_(config.lcm.url),
       filter_(config.platform, config.safety, config.actuators, reference),
       health_("safety", config.lcm.channels.health, config.lcm.health_rate_hz),
       stale_age_us_(static_cast<int64_t>(config.safety.stale_age_s * 1e6)) {
-  lcm_->subscribe(config.lcm.channels.state_estimate, &SafetyNode::OnState, this)
-      ->setQueueCapacity(kQueueCapacity);
-  lcm_->subscribe(config.lcm.channels.command_nominal, &SafetyNode::OnNominal, this)
-      ->setQueueCapacity(kQueueCapacity);
+  receiver_.Subscribe(config.lcm.channels.state_estimate, &SafetyNode::OnState, this);
+  receiver_.Subscribe(config.lcm.channels.command_nominal, &SafetyNode::OnNominal, this);
   health_.SetCounter("fallback_commands", 0);
+  health_.SetCounter("active_steps", 0);
+  health_.SetCounter("infeasible", 0);
   health_.SetState(health_t::STATE_OK);
 }
 
@@ -135,9 +130,12 @@ void SafetyNode::Publish(const state_t& state, int64_t sample_utime, const Vecto
   lcm_->publish(config_.lcm.channels.safety_diagnostics, &diagnostics_msg_);
   ++seq_;
   health_.CountOut();
+  // For monitors that follow the run from the heartbeat alone.
+  if (diagnostics.flags & safety::kFlagFilterActive) health_.Count("active_steps");
+  if (diagnostics.infeasible) health_.Count("infeasible");
   (void)state;
 }
 
-int SafetyNode::Run() { return RunNodeLoop("safety", lcm_, &health_, 50); }
+int SafetyNode::Run() { return RunNodeLoop("safety", lcm_, &receiver_, &health_, 50); }
 
 }  // namespace stewart

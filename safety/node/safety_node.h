@@ -8,6 +8,7 @@
 #include "stewart/config/stack_config.h"
 #include "stewart/force_command_t.hpp"
 #include "stewart/node/health_reporter.h"
+#include "stewart/node/lcm_receiver.h"
 #include "stewart/safety/safety_filter.h"
 #include "stewart/safety_diagnostics_t.hpp"
 #include "stewart/state_t.hpp"
@@ -33,6 +34,7 @@ class SafetyNode {
 
   const StackConfig& config_;
   lcm::LCM* lcm_;
+  LcmReceiver receiver_;
   safety::SafetyFilter filter_;
   HealthReporter health_;
   const int64_t stale_age_us_;

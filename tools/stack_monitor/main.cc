@@ -18,29 +18,23 @@
 #include <string>
 
 #include "stewart/health_t.hpp"
-#include "stewart/node/lcm_handle.h"
+#include "stewart/node/lcm_receiver.h"
 #include "stewart/node/node_options.h"
 #include "stewart/node/stop_signal.h"
-#include "stewart/safety_diagnostics_t.hpp"
-#include "stewart/sensor_t.hpp"
 
 namespace stewart {
 namespace {
 
 class Monitor {
  public:
+  // Progress comes from the heartbeats alone (2 Hz by default), not from the
+  // 1 kHz streams: a monitor must not compete with the loop for the CPUs.
   void OnHealth(const lcm::ReceiveBuffer*, const std::string&, const health_t* msg) {
     health_[msg->name] = *msg;
-  }
-  void OnSensor(const lcm::ReceiveBuffer*, const std::string&, const sensor_t* msg) {
-    if (first_sample_utime_ < 0) first_sample_utime_ = msg->utime;
-    newest_sample_utime_ = msg->utime;
-  }
-  void OnDiagnostics(const lcm::ReceiveBuffer*, const std::string&,
-                     const safety_diagnostics_t* msg) {
-    ++steps_;
-    if (msg->active_case != safety_diagnostics_t::CASE_NONE) ++active_steps_;
-    if (msg->infeasible) ++infeasible_steps_;
+    if ((msg->name == "plant_sim" || msg->name == "hw_bridge") && msg->sample_utime > 0) {
+      if (first_sample_utime_ < 0) first_sample_utime_ = msg->sample_utime;
+      newest_sample_utime_ = msg->sample_utime;
+    }
   }
 
   bool Seen(const std::string& name) const { return health_.count(name) > 0; }
@@ -51,9 +45,13 @@ class Monitor {
   }
   std::string Summary() const {
     std::ostringstream s;
-    if (steps_ > 0) {
-      s << "filter active " << (100 * active_steps_ / steps_) << "% of " << steps_ << " steps";
-      if (infeasible_steps_ > 0) s << ", infeasible " << infeasible_steps_;
+    const auto safety = health_.find("safety");
+    if (safety != health_.end() && safety->second.messages_out > 0) {
+      const health_t& h = safety->second;
+      const int64_t steps = h.messages_out;
+      s << "filter active " << (100 * Counter(h, "active_steps") / steps) << "% of " << steps
+        << " steps";
+      if (Counter(h, "infeasible") > 0) s << ", infeasible " << Counter(h, "infeasible");
     }
     for (const auto& [name, h] : health_) {
       if (h.rejected_inputs > 0 || h.state >= health_t::STATE_DEGRADED) {
@@ -65,12 +63,18 @@ class Monitor {
   }
 
  private:
+  static int64_t Counter(const health_t& h, const std::string& name) {
+    for (int i = 0; i < h.num_counters; ++i) {
+      if (h.counter_names[static_cast<size_t>(i)] == name) {
+        return h.counter_values[static_cast<size_t>(i)];
+      }
+    }
+    return 0;
+  }
+
   std::map<std::string, health_t> health_;
   int64_t first_sample_utime_ = -1;
   int64_t newest_sample_utime_ = 0;
-  long steps_ = 0;
-  long active_steps_ = 0;
-  long infeasible_steps_ = 0;
 };
 
 std::set<std::string> SplitNames(const std::string& csv) {
@@ -100,28 +104,22 @@ int main(int argc, char** argv) {
   const stewart::StackConfig config = stewart::LoadNodeConfigOrExit(options);
   stewart::InstallStopSignalHandlers();
 
-  std::unique_ptr<lcm::LCM> lcm;
+  std::unique_ptr<stewart::LcmReceiver> receiver_ptr;
   try {
-    lcm = stewart::MakeLcm(config.lcm.url);
+    receiver_ptr = std::make_unique<stewart::LcmReceiver>(config.lcm.url);
   } catch (const std::exception& e) {
     spdlog::error("{}", e.what());
     return 1;
   }
   stewart::Monitor monitor;
-  lcm->subscribe(config.lcm.channels.health, &stewart::Monitor::OnHealth, &monitor);
-  if (progress_of_s > 0.0) {
-    lcm->subscribe(config.lcm.channels.sensors, &stewart::Monitor::OnSensor, &monitor)
-        ->setQueueCapacity(10000);
-    lcm->subscribe(config.lcm.channels.safety_diagnostics, &stewart::Monitor::OnDiagnostics,
-                   &monitor)
-        ->setQueueCapacity(10000);
-  }
+  stewart::LcmReceiver& receiver = *receiver_ptr;
+  receiver.Subscribe(config.lcm.channels.health, &stewart::Monitor::OnHealth, &monitor);
 
   const auto start = std::chrono::steady_clock::now();
   auto next_print = start + std::chrono::seconds(1);
   const std::set<std::string> names = stewart::SplitNames(wait_for);
   while (!stewart::StopRequested()) {
-    lcm->handleTimeout(100);
+    receiver.HandleTimeout(100);
     const auto now = std::chrono::steady_clock::now();
     if (!names.empty()) {
       bool all = true;

@@ -4,14 +4,16 @@
 #include <string>
 
 #include "stewart/node/health_reporter.h"
+#include "stewart/node/lcm_receiver.h"
 
 namespace stewart {
 
-/// The event loop of a message-driven node: handles LCM traffic and beats
-/// the heartbeat until a stop signal or until `done()` returns true. A
+/// The event loop of a message-driven node: handles the receiver's traffic
+/// and beats the heartbeat (published through `lcm`) until a stop signal or
+/// until `done()` returns true. A
 /// receive error reports FAULT and returns 1; a clean stop reports STOPPED and
 /// returns 0. A stop signal interrupting the wait (EINTR) is a clean stop.
-int RunNodeLoop(const std::string& name, lcm::LCM* lcm, HealthReporter* health, int poll_ms,
-                const std::function<bool()>& done = {});
+int RunNodeLoop(const std::string& name, lcm::LCM* lcm, LcmReceiver* receiver,
+                HealthReporter* health, int poll_ms, const std::function<bool()>& done = {});
 
 }  // namespace stewart

@@ -1,0 +1,311 @@
+#include "stewart/node/lcm_receiver.h"
+
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <poll.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <chrono>
+#include <cstdlib>
+#include <cstring>
+#include <stdexcept>
+
+#include "stewart/node/channel_filter.h"
+
+namespace stewart {
+namespace {
+
+// LCM UDP multicast protocol (all integers big-endian):
+//   short:      "LC02" | seqno u32 | channel NUL | payload
+//   fragmented: "LC03" | seqno u32 | msg_size u32 | fragment_offset u32 |
+//               fragment_no u16 | fragments_in_msg u16 | [channel NUL, in
+//               fragment 0 only] | data
+constexpr uint32_t kMagicShort = 0x4c433032;
+constexpr uint32_t kMagicLong = 0x4c433033;
+constexpr int kShortHeaderBytes = 8;
+constexpr int kLongHeaderBytes = 20;
+constexpr int kMaxChannelLength = 63;  // LCM_MAX_CHANNEL_NAME_LENGTH
+// Far above any message of this stack; a corrupt header must not make us
+// allocate LCM's 256 MiB.
+constexpr uint32_t kMaxMessageBytes = 16u << 20;
+constexpr size_t kMaxReassemblies = 4;
+constexpr int kDefaultRecvBufBytes = 2 << 20;
+constexpr int kMaxDatagramBytes = 65536;
+
+uint32_t ReadU32(const uint8_t* p) {
+  return (uint32_t{p[0]} << 24) | (uint32_t{p[1]} << 16) | (uint32_t{p[2]} << 8) | p[3];
+}
+uint16_t ReadU16(const uint8_t* p) { return static_cast<uint16_t>((p[0] << 8) | p[1]); }
+
+// Length of the NUL-terminated channel at p within `size` bytes; -1 if the
+// name is unterminated or longer than LCM allows.
+int ChannelLength(const uint8_t* p, int size) {
+  const int limit = std::min(size, kMaxChannelLength + 1);
+  for (int i = 0; i < limit; ++i) {
+    if (p[i] == 0) return i;
+  }
+  return -1;
+}
+
+int64_t WallUtime() {
+  return std::chrono::duration_cast<std::chrono::microseconds>(
+             std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+int ParseIntOrThrow(const std::string& text, const std::string& what, const std::string& url) {
+  if (text.empty() || text.find_first_not_of("0123456789") != std::string::npos) {
+    throw std::invalid_argument("LCM URL '" + url + "': " + what + " '" + text +
+                                "' is not a non-negative integer");
+  }
+  return static_cast<int>(std::strtol(text.c_str(), nullptr, 10));
+}
+
+}  // namespace
+
+struct LcmReceiver::Reassembly {
+  uint32_t sender_ip = 0;
+  uint16_t sender_port = 0;
+  uint32_t seqno = 0;
+  std::string channel;  // from fragment 0
+  std::vector<uint8_t> data;
+  std::vector<bool> received;
+  int remaining = 0;
+};
+
+UdpmAddress ParseUdpmUrl(const std::string& url_in) {
+  std::string url = url_in;
+  if (url.empty()) {
+    const char* env = std::getenv("LCM_DEFAULT_URL");
+    url = env != nullptr && *env != '\0' ? env : "udpm://239.255.76.67:7667";
+  }
+  const std::string scheme = "udpm://";
+  if (url.compare(0, scheme.size(), scheme) != 0) {
+    throw std::invalid_argument("LCM URL '" + url +
+                                "': the stack's processes need a udpm:// URL (multicast)");
+  }
+  UdpmAddress a;
+  std::string rest = url.substr(scheme.size());
+  const size_t question = rest.find('?');
+  const std::string query = question == std::string::npos ? "" : rest.substr(question + 1);
+  rest = rest.substr(0, question);
+  const size_t colon = rest.find(':');
+  if (!rest.empty()) a.group = rest.substr(0, colon);
+  if (colon != std::string::npos) {
+    a.port = ParseIntOrThrow(rest.substr(colon + 1), "port", url);
+    if (a.port <= 0 || a.port > 65535) {
+      throw std::invalid_argument("LCM URL '" + url + "': port out of range");
+    }
+  }
+  in_addr group{};
+  if (inet_aton(a.group.c_str(), &group) == 0 || !IN_MULTICAST(ntohl(group.s_addr))) {
+    throw std::invalid_argument("LCM URL '" + url + "': '" + a.group +
+                                "' is not a multicast IPv4 address");
+  }
+  size_t start = 0;
+  while (start < query.size()) {
+    const size_t amp = query.find('&', start);
+    const std::string pair = query.substr(start, amp - start);
+    start = amp == std::string::npos ? query.size() : amp + 1;
+    const size_t eq = pair.find('=');
+    if (pair.substr(0, eq) == "recv_buf_size" && eq != std::string::npos) {
+      a.recv_buf_size = ParseIntOrThrow(pair.substr(eq + 1), "recv_buf_size", url);
+    }
+  }
+  return a;
+}
+
+LcmReceiver::LcmReceiver(const std::string& url) : datagram_(kMaxDatagramBytes) {
+  const UdpmAddress address = ParseUdpmUrl(url);
+  fd_ = socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+  if (fd_ < 0) throw std::runtime_error(std::string("socket(): ") + std::strerror(errno));
+  auto fail = [&](const std::string& what) {
+    const std::string message = "LCM receiver on '" + url + "': " + what + ": " +
+                                std::strerror(errno) +
+                                ". For udpm:// URLs this usually means there is no multicast "
+                                "route: run 'ip route add 224.0.0.0/4 dev lo' (as root) or see "
+                                "docs/operations.md#troubleshooting";
+    close(fd_);
+    fd_ = -1;
+    throw std::runtime_error(message);
+  };
+  // As lcm::LCM does: every process on the bus binds the same port.
+  const int one = 1;
+  if (setsockopt(fd_, SOL_SOCKET, SO_REUSEADDR, &one, sizeof(one)) != 0) fail("SO_REUSEADDR");
+  const int buf = address.recv_buf_size > 0 ? address.recv_buf_size : kDefaultRecvBufBytes;
+  setsockopt(fd_, SOL_SOCKET, SO_RCVBUF, &buf, sizeof(buf));  // capped by rmem_max; best effort
+  sockaddr_in bind_address{};
+  bind_address.sin_family = AF_INET;
+  bind_address.sin_addr.s_addr = htonl(INADDR_ANY);
+  bind_address.sin_port = htons(static_cast<uint16_t>(address.port));
+  if (bind(fd_, reinterpret_cast<const sockaddr*>(&bind_address), sizeof(bind_address)) != 0) {
+    fail("bind to port " + std::to_string(address.port));
+  }
+  ip_mreq membership{};
+  inet_aton(address.group.c_str(), &membership.imr_multiaddr);
+  membership.imr_interface.s_addr = htonl(INADDR_ANY);
+  if (setsockopt(fd_, IPPROTO_IP, IP_ADD_MEMBERSHIP, &membership, sizeof(membership)) != 0) {
+    fail("joining multicast group " + address.group);
+  }
+  AttachFilter();  // nothing subscribed yet: only fragments pass
+}
+
+LcmReceiver::~LcmReceiver() {
+  if (fd_ >= 0) close(fd_);
+}
+
+void LcmReceiver::AddSubscription(const std::string& channel, Dispatch dispatch) {
+  subscriptions_.push_back(Subscription{channel, std::move(dispatch)});
+  AttachFilter();
+}
+
+void LcmReceiver::AttachFilter() {
+  std::vector<std::string> channels;
+  for (const Subscription& s : subscriptions_) channels.push_back(s.channel);
+  std::vector<sock_filter> program = BuildLcmChannelFilter(channels);
+  filter_attached_ = false;
+  if (program.empty()) return;
+  sock_fprog fprog{static_cast<unsigned short>(program.size()), program.data()};
+  filter_attached_ = setsockopt(fd_, SOL_SOCKET, SO_ATTACH_FILTER, &fprog, sizeof(fprog)) == 0;
+}
+
+int LcmReceiver::HandleTimeout(int timeout_ms) {
+  pollfd p{fd_, POLLIN, 0};
+  const int ready = poll(&p, 1, timeout_ms);
+  if (ready < 0) return errno == EINTR ? 0 : -1;
+  if (ready == 0) return 0;
+  int handled = 0;
+  for (;;) {
+    sockaddr_in from{};
+    socklen_t from_len = sizeof(from);
+    const ssize_t size = recvfrom(fd_, datagram_.data(), datagram_.size(), MSG_DONTWAIT,
+                                  reinterpret_cast<sockaddr*>(&from), &from_len);
+    if (size < 0) {
+      if (errno == EAGAIN || errno == EWOULDBLOCK) break;
+      if (errno == EINTR) break;
+      return handled > 0 ? handled : -1;
+    }
+    ++counters_.datagrams;
+    handled += HandleDatagram(datagram_.data(), static_cast<int>(size), from.sin_addr.s_addr,
+                              from.sin_port, WallUtime());
+  }
+  return handled;
+}
+
+int LcmReceiver::HandleDatagram(const uint8_t* data, int size, uint32_t sender_ip,
+                                uint16_t sender_port, int64_t recv_utime) {
+  if (size < kShortHeaderBytes) {
+    ++counters_.bad_datagrams;
+    return 0;
+  }
+  const uint32_t magic = ReadU32(data);
+  if (magic == kMagicShort) {
+    const int length = ChannelLength(data + kShortHeaderBytes, size - kShortHeaderBytes);
+    if (length < 0) {
+      ++counters_.bad_datagrams;
+      return 0;
+    }
+    const char* channel = reinterpret_cast<const char*>(data + kShortHeaderBytes);
+    const int offset = kShortHeaderBytes + length + 1;
+    return Deliver(channel, data + offset, static_cast<uint32_t>(size - offset), recv_utime);
+  }
+  if (magic != kMagicLong || size < kLongHeaderBytes) {
+    ++counters_.bad_datagrams;
+    return 0;
+  }
+  const uint32_t seqno = ReadU32(data + 4);
+  const uint32_t msg_size = ReadU32(data + 8);
+  const uint32_t fragment_offset = ReadU32(data + 12);
+  const uint16_t fragment_no = ReadU16(data + 16);
+  const uint16_t fragments = ReadU16(data + 18);
+  if (msg_size == 0 || msg_size > kMaxMessageBytes || fragments == 0 || fragment_no >= fragments) {
+    ++counters_.bad_datagrams;
+    return 0;
+  }
+  const uint8_t* payload = data + kLongHeaderBytes;
+  int payload_size = size - kLongHeaderBytes;
+  std::string channel;
+  if (fragment_no == 0) {
+    const int length = ChannelLength(payload, payload_size);
+    if (length < 0) {
+      ++counters_.bad_datagrams;
+      return 0;
+    }
+    channel.assign(reinterpret_cast<const char*>(payload), static_cast<size_t>(length));
+    payload += length + 1;
+    payload_size -= length + 1;
+  }
+  if (static_cast<uint64_t>(fragment_offset) + static_cast<uint64_t>(payload_size) > msg_size) {
+    ++counters_.bad_datagrams;
+    return 0;
+  }
+  Reassembly* r = nullptr;
+  for (auto& candidate : reassemblies_) {
+    if (candidate->sender_ip == sender_ip && candidate->sender_port == sender_port &&
+        candidate->seqno == seqno) {
+      r = candidate.get();
+    }
+  }
+  if (r != nullptr && (r->data.size() != msg_size || r->received.size() != fragments)) {
+    r = nullptr;  // a different message under a reused sequence number
+    for (auto it = reassemblies_.begin(); it != reassemblies_.end(); ++it) {
+      if ((*it)->sender_ip == sender_ip && (*it)->sender_port == sender_port &&
+          (*it)->seqno == seqno) {
+        reassemblies_.erase(it);
+        ++counters_.incomplete_fragmented;
+        break;
+      }
+    }
+  }
+  if (r == nullptr) {
+    if (reassemblies_.size() >= kMaxReassemblies) {
+      reassemblies_.erase(reassemblies_.begin());  // the oldest lost a fragment
+      ++counters_.incomplete_fragmented;
+    }
+    auto fresh = std::make_unique<Reassembly>();
+    fresh->sender_ip = sender_ip;
+    fresh->sender_port = sender_port;
+    fresh->seqno = seqno;
+    fresh->data.resize(msg_size);
+    fresh->received.assign(fragments, false);
+    fresh->remaining = fragments;
+    r = fresh.get();
+    reassemblies_.push_back(std::move(fresh));
+  }
+  if (r->received[fragment_no]) return 0;  // a duplicate
+  r->received[fragment_no] = true;
+  --r->remaining;
+  if (fragment_no == 0) r->channel = channel;
+  std::memcpy(r->data.data() + fragment_offset, payload, static_cast<size_t>(payload_size));
+  if (r->remaining > 0) return 0;
+  // Complete: take it out of the list before delivering.
+  std::unique_ptr<Reassembly> done;
+  for (auto it = reassemblies_.begin(); it != reassemblies_.end(); ++it) {
+    if (it->get() == r) {
+      done = std::move(*it);
+      reassemblies_.erase(it);
+      break;
+    }
+  }
+  return Deliver(done->channel.c_str(), done->data.data(), msg_size, recv_utime);
+}
+
+int LcmReceiver::Deliver(const char* channel, const uint8_t* data, uint32_t size,
+                         int64_t recv_utime) {
+  int handled = 0;
+  for (Subscription& s : subscriptions_) {
+    if (s.channel != channel) continue;
+    lcm::ReceiveBuffer rbuf{const_cast<uint8_t*>(data), size, recv_utime};
+    if (s.dispatch(rbuf, s.channel)) {
+      ++handled;
+      ++counters_.messages;
+    } else {
+      ++counters_.decode_failures;
+    }
+  }
+  return handled;
+}
+
+}  // namespace stewart

@@ -1,0 +1,256 @@
+// The nodes' LCM receiver: URL parsing, the kernel channel filter on a real
+// socket, and end to end against lcm::LCM publishing short and fragmented
+// messages, with hostile datagrams in between. Private LCM ports 7801-7804.
+#include "stewart/node/lcm_receiver.h"
+
+#include <arpa/inet.h>
+#include <gtest/gtest.h>
+#include <netinet/in.h>
+#include <poll.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstring>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "stewart/force_command_t.hpp"
+#include "stewart/health_t.hpp"
+#include "stewart/node/channel_filter.h"
+#include "stewart/node/lcm_handle.h"
+
+namespace stewart {
+namespace {
+
+TEST(ParseUdpmUrl, ReadsGroupPortAndBufferSize) {
+  const UdpmAddress a = ParseUdpmUrl("udpm://239.255.76.67:7801?ttl=0&recv_buf_size=65536");
+  EXPECT_EQ(a.group, "239.255.76.67");
+  EXPECT_EQ(a.port, 7801);
+  EXPECT_EQ(a.recv_buf_size, 65536);
+  const UdpmAddress no_port = ParseUdpmUrl("udpm://239.1.2.3");
+  EXPECT_EQ(no_port.group, "239.1.2.3");
+  EXPECT_EQ(no_port.port, 7667);
+  EXPECT_EQ(no_port.recv_buf_size, 0);
+}
+
+TEST(ParseUdpmUrl, RejectsWhatItCannotReceive) {
+  EXPECT_THROW(ParseUdpmUrl("memq://"), std::invalid_argument);
+  EXPECT_THROW(ParseUdpmUrl("udpm://239.255.76.67:notaport"), std::invalid_argument);
+  EXPECT_THROW(ParseUdpmUrl("udpm://239.255.76.67:70000"), std::invalid_argument);
+  EXPECT_THROW(ParseUdpmUrl("udpm://127.0.0.1:7667"), std::invalid_argument);  // not multicast
+  EXPECT_THROW(ParseUdpmUrl("udpm://239.255.76.67:7667?recv_buf_size=-1"), std::invalid_argument);
+}
+
+// An LCM short datagram: "LC02", seqno, channel NUL, payload.
+std::vector<uint8_t> ShortDatagram(const std::string& channel, size_t payload_bytes) {
+  const uint8_t header[8] = {'L', 'C', '0', '2', 0, 0, 0, 7};
+  std::vector<uint8_t> d(8 + channel.size() + 1 + payload_bytes, 0xAB);
+  std::memcpy(d.data(), header, sizeof(header));
+  std::memcpy(d.data() + 8, channel.data(), channel.size());
+  d[8 + channel.size()] = 0;
+  return d;
+}
+
+// Sends datagrams to a loopback socket carrying the filter; returns the
+// channel of each datagram that came through (in order).
+class FilteredSocket {
+ public:
+  explicit FilteredSocket(const std::vector<std::string>& channels) {
+    rx_ = socket(AF_INET, SOCK_DGRAM, 0);
+    tx_ = socket(AF_INET, SOCK_DGRAM, 0);
+    sockaddr_in a{};
+    a.sin_family = AF_INET;
+    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    a.sin_port = 0;
+    EXPECT_EQ(bind(rx_, reinterpret_cast<sockaddr*>(&a), sizeof(a)), 0);
+    socklen_t len = sizeof(address_);
+    getsockname(rx_, reinterpret_cast<sockaddr*>(&address_), &len);
+    std::vector<sock_filter> program = BuildLcmChannelFilter(channels);
+    EXPECT_FALSE(program.empty());
+    sock_fprog fprog{static_cast<unsigned short>(program.size()), program.data()};
+    EXPECT_EQ(setsockopt(rx_, SOL_SOCKET, SO_ATTACH_FILTER, &fprog, sizeof(fprog)), 0)
+        << std::strerror(errno);
+  }
+  ~FilteredSocket() {
+    close(rx_);
+    close(tx_);
+  }
+  void Send(const std::vector<uint8_t>& d) {
+    sendto(tx_, d.data(), d.size(), 0, reinterpret_cast<const sockaddr*>(&address_),
+           sizeof(address_));
+  }
+  // Sizes of the datagrams that passed, after a marker datagram that always
+  // passes (not LC02) tells the queue is drained.
+  std::vector<size_t> Drain() {
+    Send({'E', 'N', 'D', '!', 0, 0, 0, 0});
+    std::vector<size_t> sizes;
+    uint8_t buf[70000];
+    for (;;) {
+      pollfd p{rx_, POLLIN, 0};
+      if (poll(&p, 1, 1000) <= 0) break;
+      const ssize_t n = recv(rx_, buf, sizeof(buf), 0);
+      if (n < 0) break;
+      if (n == 8 && std::memcmp(buf, "END!", 4) == 0) break;
+      sizes.push_back(static_cast<size_t>(n));
+    }
+    return sizes;
+  }
+
+ private:
+  int rx_ = -1, tx_ = -1;
+  sockaddr_in address_{};
+};
+
+TEST(LcmChannelFilter, PassesExactlyTheSubscribedChannelsAndEveryFragment) {
+  FilteredSocket s({"STEWART_SENSORS", "A", "STEWART_CMD_SAFE"});
+  // Each datagram gets a distinct payload size so the survivors can be named.
+  s.Send(ShortDatagram("STEWART_SENSORS", 1));      // pass
+  s.Send(ShortDatagram("STEWART_SENSORS_X", 2));    // longer name: drop
+  s.Send(ShortDatagram("STEWART_SENSOR", 3));       // a prefix: drop
+  s.Send(ShortDatagram("A", 4));                    // pass
+  s.Send(ShortDatagram("AB", 5));                   // drop
+  s.Send(ShortDatagram("STEWART_CMD_SAFE", 6));     // pass (name length a multiple of 4)
+  s.Send(ShortDatagram("STEWART_CMD_NOMINAL", 7));  // drop
+  s.Send(ShortDatagram("", 8));                     // drop
+  std::vector<uint8_t> fragment = {'L', 'C', '0', '3'};
+  fragment.resize(40, 1);
+  s.Send(fragment);               // fragments always pass
+  s.Send(ShortDatagram("A", 0));  // a short one at the end of the datagram
+  const std::vector<size_t> sizes = s.Drain();
+  const std::vector<size_t> expected = {
+      ShortDatagram("STEWART_SENSORS", 1).size(), ShortDatagram("A", 4).size(),
+      ShortDatagram("STEWART_CMD_SAFE", 6).size(), fragment.size(), ShortDatagram("A", 0).size()};
+  EXPECT_EQ(sizes, expected);
+}
+
+TEST(LcmChannelFilter, DropsEverythingShortWithNoSubscription) {
+  FilteredSocket s({});
+  s.Send(ShortDatagram("ANY", 10));
+  s.Send({'L', 'C', '0', '2'});  // truncated header: the program's load fails, dropped
+  EXPECT_TRUE(s.Drain().empty());
+}
+
+struct Sink {
+  void OnCommand(const lcm::ReceiveBuffer*, const std::string& channel,
+                 const force_command_t* msg) {
+    channels.push_back(channel);
+    seqs.push_back(msg->seq);
+  }
+  void OnHealth(const lcm::ReceiveBuffer* rbuf, const std::string&, const health_t* msg) {
+    health_errors.push_back(msg->last_error);
+    health_sizes.push_back(rbuf->data_size);
+  }
+  std::vector<std::string> channels;
+  std::vector<int64_t> seqs;
+  std::vector<std::string> health_errors;
+  std::vector<uint32_t> health_sizes;
+};
+
+void PumpUntil(LcmReceiver* r, const std::function<bool()>& done, double seconds = 3.0) {
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+  while (!done() && std::chrono::steady_clock::now() < end) r->HandleTimeout(20);
+}
+
+TEST(LcmReceiver, ReceivesShortAndFragmentedMessagesFromLcmAndOnlyItsChannels) {
+  const std::string url = PrivateLcmUrl(7802);
+  LcmReceiver receiver(url);
+  Sink sink;
+  receiver.Subscribe("CMD", &Sink::OnCommand, &sink);
+  receiver.Subscribe("BIG", &Sink::OnHealth, &sink);
+  EXPECT_TRUE(receiver.kernel_filter_attached());
+  auto lcm = MakeLcm(url);
+
+  force_command_t command{};
+  for (int i = 0; i < 50; ++i) {
+    command.seq = i;
+    lcm->publish("CMD", &command);
+    lcm->publish("OTHER", &command);  // not subscribed
+    lcm->publish("CMDX", &command);   // not subscribed, a longer name
+  }
+  health_t big{};
+  big.name = "big";
+  big.last_error = std::string(20000, 'x');  // ~15 fragments of 1400 bytes in LCM 1.3.1
+  lcm->publish("BIG", &big);
+  PumpUntil(&receiver, [&] { return sink.seqs.size() == 50 && sink.health_errors.size() == 1; });
+
+  ASSERT_EQ(sink.seqs.size(), 50u);
+  for (int i = 0; i < 50; ++i) {
+    EXPECT_EQ(sink.seqs[static_cast<size_t>(i)], i);
+    EXPECT_EQ(sink.channels[static_cast<size_t>(i)], "CMD");
+  }
+  ASSERT_EQ(sink.health_errors.size(), 1u);
+  EXPECT_EQ(sink.health_errors[0], big.last_error);
+  EXPECT_EQ(sink.health_sizes[0], static_cast<uint32_t>(big.getEncodedSize()));
+  // The kernel dropped OTHER and CMDX: the socket never saw them.
+  EXPECT_EQ(receiver.counters().messages, 51);
+  EXPECT_LT(receiver.counters().datagrams, 50 + 20);
+  EXPECT_EQ(receiver.counters().decode_failures, 0);
+}
+
+// Raw datagrams to the bus, as a broken or hostile sender would send them.
+class BusSender {
+ public:
+  explicit BusSender(int port) : fd_(socket(AF_INET, SOCK_DGRAM, 0)) {
+    const unsigned char ttl = 0;
+    setsockopt(fd_, IPPROTO_IP, IP_MULTICAST_TTL, &ttl, sizeof(ttl));
+    to_.sin_family = AF_INET;
+    to_.sin_port = htons(static_cast<uint16_t>(port));
+    inet_aton("239.255.76.67", &to_.sin_addr);
+  }
+  ~BusSender() { close(fd_); }
+  void Send(const std::vector<uint8_t>& d) {
+    sendto(fd_, d.data(), d.size(), 0, reinterpret_cast<const sockaddr*>(&to_), sizeof(to_));
+  }
+
+ private:
+  int fd_;
+  sockaddr_in to_{};
+};
+
+std::vector<uint8_t> Fragment(uint32_t seqno, uint32_t msg_size, uint32_t offset, uint16_t number,
+                              uint16_t count, const std::vector<uint8_t>& body) {
+  std::vector<uint8_t> d = {'L', 'C', '0', '3'};
+  auto put32 = [&](uint32_t v) {
+    for (int s = 24; s >= 0; s -= 8) d.push_back(static_cast<uint8_t>(v >> s));
+  };
+  put32(seqno);
+  put32(msg_size);
+  put32(offset);
+  d.push_back(static_cast<uint8_t>(number >> 8));
+  d.push_back(static_cast<uint8_t>(number));
+  d.push_back(static_cast<uint8_t>(count >> 8));
+  d.push_back(static_cast<uint8_t>(count));
+  d.insert(d.end(), body.begin(), body.end());
+  return d;
+}
+
+TEST(LcmReceiver, CountsHostileDatagramsAndKeepsWorking) {
+  const std::string url = PrivateLcmUrl(7803);
+  LcmReceiver receiver(url);
+  Sink sink;
+  receiver.Subscribe("CMD", &Sink::OnCommand, &sink);
+  BusSender bus(7803);
+  std::vector<uint8_t> truncated_command = ShortDatagram("CMD", 3);  // too short to decode
+  bus.Send(truncated_command);
+  bus.Send(Fragment(1, 1u << 30, 0, 0, 2, {'C', 'M', 'D', 0}));        // absurd size
+  bus.Send(Fragment(2, 100, 90, 1, 2, std::vector<uint8_t>(20, 0)));   // past the end
+  bus.Send(Fragment(3, 100, 0, 3, 2, {}));                             // number >= count
+  bus.Send(Fragment(4, 100, 0, 0, 2, std::vector<uint8_t>(10, 'Z')));  // unterminated channel
+  bus.Send({'L', 'C', '0', '3', 1, 2});                                // truncated header
+  // The fragment of a message that never completes, then a good message.
+  bus.Send(Fragment(5, 1000, 0, 0, 2, {'C', 'M', 'D', 0, 1, 2, 3}));
+  auto lcm = MakeLcm(url);
+  force_command_t command{};
+  command.seq = 42;
+  lcm->publish("CMD", &command);
+  PumpUntil(&receiver, [&] { return !sink.seqs.empty(); });
+  ASSERT_EQ(sink.seqs.size(), 1u);
+  EXPECT_EQ(sink.seqs[0], 42);
+  EXPECT_EQ(receiver.counters().decode_failures, 1);
+  EXPECT_EQ(receiver.counters().bad_datagrams, 5);
+}
+
+}  // namespace
+}  // namespace stewart
