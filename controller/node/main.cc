@@ -42,6 +42,8 @@ int main(int argc, char** argv) {
   }
 
   const stewart::StackConfig config = stewart::LoadNodeConfigOrExit(node_options);
+
+  stewart::PrepareForRealTimeIfScheduled("controller");
   if (scenario) {
     if (auto t = stewart::FirstTimeOutsideWorkspace(*scenario, config.platform)) {
       spdlog::warn(

@@ -18,6 +18,7 @@ int main(int argc, char** argv) {
                "republish the simulator's ground truth instead of estimating (testing only)");
   CLI11_PARSE(app, argc, argv);
   const stewart::StackConfig config = stewart::LoadNodeConfigOrExit(options);
+  stewart::PrepareForRealTimeIfScheduled("estimator");
   try {
     auto lcm = stewart::MakeLcm(config.lcm.url);
     stewart::InstallStopSignalHandlers();

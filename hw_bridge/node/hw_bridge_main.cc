@@ -204,6 +204,8 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
 
   StackConfig config = LoadNodeConfigOrExit(options);
+
+  PrepareForRealTimeIfScheduled("hw_bridge");
   HwBridgeConfig& hw = config.hw_bridge;
   if (!transport.empty()) hw.transport = transport;
   if (!serial_device.empty()) hw.serial_device = serial_device;

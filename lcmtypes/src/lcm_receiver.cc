@@ -172,8 +172,17 @@ void LcmReceiver::AttachFilter() {
 }
 
 int LcmReceiver::HandleTimeout(int timeout_ms) {
+  return HandleTimeoutUs(timeout_ms < 0 ? -1 : int64_t{timeout_ms} * 1000);
+}
+
+int LcmReceiver::HandleTimeoutUs(int64_t timeout_us) {
   pollfd p{fd_, POLLIN, 0};
-  const int ready = poll(&p, 1, timeout_ms);
+  timespec timeout{};
+  if (timeout_us > 0) {
+    timeout.tv_sec = static_cast<time_t>(timeout_us / 1000000);
+    timeout.tv_nsec = static_cast<long>((timeout_us % 1000000) * 1000);
+  }
+  const int ready = ppoll(&p, 1, timeout_us < 0 ? nullptr : &timeout, nullptr);
   if (ready < 0) return errno == EINTR ? 0 : -1;
   if (ready == 0) return 0;
   int handled = 0;

@@ -1,8 +1,12 @@
 #include "stewart/node/node_options.h"
 
+#include <sched.h>
 #include <spdlog/spdlog.h>
+#include <sys/mman.h>
 
+#include <cerrno>
 #include <cstdlib>
+#include <cstring>
 
 namespace stewart {
 
@@ -26,6 +30,20 @@ StackConfig LoadNodeConfigOrExit(const NodeOptions& options) {
   } catch (const ConfigError& e) {
     spdlog::error("{} (file: {})", e.what(), options.config_path);
     std::exit(2);
+  }
+}
+
+void PrepareForRealTimeIfScheduled(const std::string& name) {
+  const int policy = sched_getscheduler(0);
+  if (policy != SCHED_FIFO && policy != SCHED_RR) return;
+  sched_param param{};
+  sched_getparam(0, &param);
+  if (mlockall(MCL_CURRENT | MCL_FUTURE) == 0) {
+    spdlog::info("{}: {} priority {}, memory locked", name,
+                 policy == SCHED_FIFO ? "SCHED_FIFO" : "SCHED_RR", param.sched_priority);
+  } else {
+    spdlog::warn("{}: real-time priority {} but mlockall failed ({}): page faults may stall ticks",
+                 name, param.sched_priority, std::strerror(errno));
   }
 }
 

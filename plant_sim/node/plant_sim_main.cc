@@ -60,6 +60,8 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
 
   stewart::StackConfig config = stewart::LoadNodeConfigOrExit(node_options);
+
+  stewart::PrepareForRealTimeIfScheduled("plant_sim");
   if (!ToVector6(initial_pose, "--initial-pose", &config.plant_sim.initial_pose) ||
       !ToVector6(initial_velocity, "--initial-velocity", &config.plant_sim.initial_velocity)) {
     return 2;

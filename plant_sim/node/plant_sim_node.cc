@@ -4,7 +4,6 @@
 
 #include <chrono>
 #include <cmath>
-#include <thread>
 
 #include "stewart/node/eigen_msg.h"
 #include "stewart/node/lcm_handle.h"
@@ -60,7 +59,12 @@ int PlantSimNode::Run() {
     status = 4;
   }
   if (status == 0) health_.SetState(health_t::STATE_STOPPED);
+  UpdateLatencyCounters();
   health_.MaybePublish(lcm_.get(), true);
+  spdlog::info(
+      "plant_sim: sample-to-command latency p50 {} us, p99 {} us, max {} us ({} answered "
+      "samples)",
+      latency_.Percentile(0.50), latency_.Percentile(0.99), latency_.max_us(), latency_.count());
   const PlantCounters c = plant_.counters();
   spdlog::info("plant_sim: stopped at t = {:.3f} s after {} ticks; {} end-stop hits, {} rhs evals",
                plant_.time_s(), tick_, c.endstop_hits, c.ode.rhs_evals);
@@ -86,6 +90,9 @@ void PlantSimNode::PublishSample() {
   if (plant_.InEndStop()) s.status |= sensor_t::STATUS_ENDSTOP;
   if (plant_.actuators_off()) s.status |= sensor_t::STATUS_ACTUATORS_OFF;
   lcm_->publish(config_.lcm.channels.sensors, &s);
+  const size_t slot = static_cast<size_t>(tick_ % kSentRing);
+  sent_sample_utime_[slot] = tick_utime_;
+  sent_at_[slot] = std::chrono::steady_clock::now();
 
   state_t truth{};
   truth.utime = tick_utime_;
@@ -105,6 +112,7 @@ void PlantSimNode::AdvanceTick() {
   const PlantCounters c = plant_.counters();
   health_.SetCounter("endstop_hits", c.endstop_hits);
   health_.SetCounter("ticks", tick_ + 1);
+  if (tick_ % 100 == 0) UpdateLatencyCounters();
   health_.MaybePublish(lcm_.get());
 }
 
@@ -117,6 +125,7 @@ void PlantSimNode::HandleCommand(const lcm::ReceiveBuffer*, const std::string&,
     health_.Reject(problem, "force_command_t seq " + std::to_string(msg->seq));
     return;
   }
+  RecordLatency(msg->sample_utime);
   if (options_.mode == SimMode::kLockstep) {
     switch (MatchLockstepCommand(tick_utime_, msg->sample_utime)) {
       case LockstepMatch::kAnswer:
@@ -147,6 +156,24 @@ void PlantSimNode::HandleCommand(const lcm::ReceiveBuffer*, const std::string&,
   }
   last_applied_sample_utime_ = msg->sample_utime;
   hold_.OnCommand(force_n, plant_.time_s());
+}
+
+void PlantSimNode::RecordLatency(int64_t sample_utime) {
+  if (sample_utime <= newest_timed_sample_utime_ || sample_utime < utime0_) return;
+  const int64_t tick = (sample_utime - utime0_) / period_us_;
+  const size_t slot = static_cast<size_t>(tick % kSentRing);
+  if (tick > tick_ || sent_sample_utime_[slot] != sample_utime) return;  // unknown or too old
+  newest_timed_sample_utime_ = sample_utime;
+  latency_.Add(std::chrono::duration_cast<std::chrono::microseconds>(
+                   std::chrono::steady_clock::now() - sent_at_[slot])
+                   .count());
+}
+
+void PlantSimNode::UpdateLatencyCounters() {
+  health_.SetCounter("answered_samples", latency_.count());
+  health_.SetCounter("latency_p50_us", latency_.Percentile(0.50));
+  health_.SetCounter("latency_p99_us", latency_.Percentile(0.99));
+  health_.SetCounter("latency_max_us", latency_.max_us());
 }
 
 void PlantSimNode::ApplyRealTimeDecision() {
@@ -185,15 +212,13 @@ int PlantSimNode::RunRealTime() {
     const Clock::time_point deadline = start + tick_ * period;
     // Commands are taken in while waiting for the tick; the one newest at
     // the tick acts over the whole following interval (zero-order hold).
+    // Waiting on the socket until the deadline (not sleeping) takes each
+    // command in as it arrives, so its latency is measured when it lands.
     while (!StopRequested()) {
       const Clock::duration left = deadline - Clock::now();
       if (left <= Clock::duration::zero()) break;
-      if (left < std::chrono::milliseconds(1)) {
-        receiver_.HandleTimeout(0);
-        std::this_thread::sleep_until(deadline);
-        break;
-      }
-      receiver_.HandleTimeout(TimeoutMs(left));
+      receiver_.HandleTimeoutUs(std::min<int64_t>(
+          std::chrono::duration_cast<std::chrono::microseconds>(left).count() + 1, 50000));
     }
     while (receiver_.HandleTimeout(0) > 0) {
     }

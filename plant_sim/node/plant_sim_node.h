@@ -2,6 +2,8 @@
 // The plant_sim process: the simulated platform on LCM (docs/simulation.md).
 // Publishes sensor_t and the ground-truth state_t at every tick, health_t as
 // a heartbeat, and applies force_command_t from the safety filter.
+#include <array>
+#include <chrono>
 #include <lcm/lcm-cpp.hpp>
 #include <memory>
 #include <string>
@@ -9,6 +11,7 @@
 #include "stewart/config/stack_config.h"
 #include "stewart/force_command_t.hpp"
 #include "stewart/node/health_reporter.h"
+#include "stewart/node/latency_histogram.h"
 #include "stewart/node/lcm_receiver.h"
 #include "stewart/plant_sim/command_policy.h"
 #include "stewart/plant_sim/plant.h"
@@ -44,6 +47,8 @@ class PlantSimNode {
   void AdvanceTick();
   void HandleCommand(const lcm::ReceiveBuffer* rbuf, const std::string& channel,
                      const force_command_t* msg);
+  void RecordLatency(int64_t sample_utime);
+  void UpdateLatencyCounters();
 
   StackConfig config_;
   PlantSimOptions options_;
@@ -62,6 +67,13 @@ class PlantSimNode {
   Vector6d answer_force_n_ = Vector6d::Zero();
   bool fallback_active_ = false;
   sensor_t last_sensor_{};
+  // The loop's latency as the plant sees it: from publishing sample k to
+  // receiving the first command derived from it (wall clock, both ends here).
+  static constexpr int kSentRing = 64;
+  std::array<int64_t, kSentRing> sent_sample_utime_{};
+  std::array<std::chrono::steady_clock::time_point, kSentRing> sent_at_{};
+  int64_t newest_timed_sample_utime_ = -1;
+  LatencyHistogram latency_;
 };
 
 }  // namespace stewart

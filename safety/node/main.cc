@@ -21,6 +21,7 @@ int main(int argc, char** argv) {
   app.add_flag("--force-limits", force_limits, "also enforce |F_i| <= actuators.force_limit_n");
   CLI11_PARSE(app, argc, argv);
   stewart::StackConfig config = stewart::LoadNodeConfigOrExit(options);
+  stewart::PrepareForRealTimeIfScheduled("safety");
   try {
     if (!variant.empty()) config.safety.variant = stewart::ParseSafetyVariant(variant);
   } catch (const std::invalid_argument& e) {

@@ -157,7 +157,7 @@ void ExerciseLink(Stack* stack, bool expect_lost) {
   const std::size_t held = stack->sensors.size();
   // Counts are loose on purpose: under a loaded CI the rates sag; the
   // assertions are about behaviour, not speed.
-  ASSERT_GT(held, 100U) << "sensor_t is not flowing";
+  ASSERT_GT(held, 100U) << "sensor_t is not flowing: " << held << " samples in 0.8 s";
   const double before = MeanLegLength(stack->sensors, held - 50, held);
   // +0.5 N on every leg for 0.1 s (~3 m/s^2 up), then commands stop: the
   // bridge goes stale after command_timeout_s and the locked legs hold.

@@ -82,6 +82,9 @@ class LcmReceiver {
   /// every datagram already queued. Returns the number of messages handed
   /// to subscribers (0 on timeout), or -1 on a receive error.
   int HandleTimeout(int timeout_ms);
+  /// The same with a microsecond timeout (ppoll), for loops paced to a
+  /// deadline: the wait ends when a datagram arrives, not at the next ms.
+  int HandleTimeoutUs(int64_t timeout_us);
 
   /// The socket, for poll() alongside other descriptors.
   int fd() const { return fd_; }

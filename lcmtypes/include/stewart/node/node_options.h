@@ -21,4 +21,10 @@ void AddNodeOptions(CLI::App* app, NodeOptions* options);
 /// line naming the key and exits with status 2.
 StackConfig LoadNodeConfigOrExit(const NodeOptions& options);
 
+/// When the process was started with a real-time scheduling policy
+/// (SCHED_FIFO/RR, e.g. by tools/launch.sh in real time), locks its memory
+/// (mlockall) so no page fault stalls a control tick, and logs the policy.
+/// Does nothing under normal scheduling.
+void PrepareForRealTimeIfScheduled(const std::string& name);
+
 }  // namespace stewart
