@@ -16,6 +16,7 @@
 #include "stewart/node/health_reporter.h"
 #include "stewart/node/lcm_handle.h"
 #include "stewart/node/lcm_receiver.h"
+#include "stewart/node/node_loop.h"
 #include "stewart/node/node_options.h"
 #include "stewart/node/stop_signal.h"
 #include "stewart/sensor_t.hpp"
@@ -123,6 +124,7 @@ class BridgeNode {
   void UpdateHealth() {
     const hw::BridgeCounters& c = bridge_.counters();
     const hw::RxStats& rx = transport_->datagram() ? datagram_stats_ : parser_.stats();
+    ReportReceiverCounters(receiver_, &health_);
     health_.SetCounter("sensor_frames", static_cast<int64_t>(c.sensor_frames));
     health_.SetCounter("lost_frames", static_cast<int64_t>(c.lost_frames));
     health_.SetCounter("corrupt_frames", static_cast<int64_t>(rx.corrupt()));

@@ -6,6 +6,11 @@
 
 namespace stewart {
 
+void ReportReceiverCounters(const LcmReceiver& receiver, HealthReporter* health) {
+  health->SetCounter("rx_bad", receiver.counters().bad_datagrams);
+  health->SetCounter("rx_decode_fail", receiver.counters().decode_failures);
+}
+
 int RunNodeLoop(const std::string& name, lcm::LCM* lcm, LcmReceiver* receiver,
                 HealthReporter* health, int poll_ms, const std::function<bool()>& done) {
   health->MaybePublish(lcm, true);
@@ -16,6 +21,7 @@ int RunNodeLoop(const std::string& name, lcm::LCM* lcm, LcmReceiver* receiver,
       health->MaybePublish(lcm, true);
       return 1;
     }
+    ReportReceiverCounters(*receiver, health);
     health->MaybePublish(lcm);
     if (done && done()) break;
   }

@@ -7,6 +7,7 @@
 
 #include "stewart/node/eigen_msg.h"
 #include "stewart/node/lcm_handle.h"
+#include "stewart/node/node_loop.h"
 #include "stewart/node/stop_signal.h"
 #include "stewart/sensor_t.hpp"
 #include "stewart/state_t.hpp"
@@ -112,7 +113,10 @@ void PlantSimNode::AdvanceTick() {
   const PlantCounters c = plant_.counters();
   health_.SetCounter("endstop_hits", c.endstop_hits);
   health_.SetCounter("ticks", tick_ + 1);
-  if (tick_ % 100 == 0) UpdateLatencyCounters();
+  if (tick_ % 100 == 0) {
+    UpdateLatencyCounters();
+    ReportReceiverCounters(receiver_, &health_);
+  }
   health_.MaybePublish(lcm_.get());
 }
 

@@ -13,6 +13,11 @@ namespace stewart {
 /// until `done()` returns true. A
 /// receive error reports FAULT and returns 1; a clean stop reports STOPPED and
 /// returns 0. A stop signal interrupting the wait (EINTR) is a clean stop.
+/// Puts the receiver's counts of unusable input into the heartbeat:
+/// rx_bad (datagrams that are not valid LCM) and rx_decode_fail (messages
+/// on a subscribed channel that did not decode as its type).
+void ReportReceiverCounters(const LcmReceiver& receiver, HealthReporter* health);
+
 int RunNodeLoop(const std::string& name, lcm::LCM* lcm, LcmReceiver* receiver,
                 HealthReporter* health, int poll_ms, const std::function<bool()>& done = {});
 
