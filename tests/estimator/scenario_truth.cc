@@ -55,6 +55,11 @@ constexpr std::array<std::array<double, 3>, 3> kWiggle = {{
     {0.015, 0.10, 2.0},
 }};
 
+SensorConfig WithSeed(SensorConfig sensors, unsigned seed) {
+  sensors.seed = seed;
+  return sensors;
+}
+
 }  // namespace
 
 ScenarioTruth::ScenarioTruth(const StackConfig& config, unsigned seed, bool angular_motion,
@@ -64,6 +69,7 @@ ScenarioTruth::ScenarioTruth(const StackConfig& config, unsigned seed, bool angu
       disturbance_(disturbance),
       period_us_(static_cast<int64_t>(1e6 / config.sensors.rate_hz)),
       gyro_bias_radps_(config.sensors.gyro_bias_radps),
+      sensor_model_(WithSeed(config.sensors, seed), config.actuators, config.platform.gravity_mps2),
       rng_(seed) {}
 
 TruthState ScenarioTruth::AnalyticState(double t_s) const {
@@ -119,29 +125,18 @@ TruthSample ScenarioTruth::Next() {
 }
 
 SensorSample ScenarioTruth::Sense(int64_t utime, const TruthState& s) {
-  const SensorConfig& sc = config_.sensors;
+  // plant_sim's sensor model, exactly as the simulator samples it; only the
+  // gyro bias's random walk (a disturbance the EKF models, for the
+  // consistency tests) is added on top of the configured constant bias.
+  const SensorReading r =
+      sensor_model_.Sample(s.q, s.qd, s.qdd, InverseKinematics(config_.platform, s.q));
   SensorSample out;
   out.utime = utime;
-  const double step = LegAdcStepM(sc, config_.actuators.stroke_m);
-  const double l_min = config_.platform.leg_min_length_m;
-  const Vector6d legs = InverseKinematics(config_.platform, s.q);
-  for (int i = 0; i < 6; ++i) {
-    double l = legs(i) + sc.leg_pot_noise_std_m * normal_(rng_);
-    if (step > 0.0) l = l_min + step * std::round((l - l_min) / step);
-    out.leg_length_m(i) = l;
-  }
-  const Vector3d gyro_noise(normal_(rng_), normal_(rng_), normal_(rng_));
-  out.gyro_radps =
-      BodyAngularVelocity(s.q, s.qd) + gyro_bias_radps_ + sc.gyro_noise_std_radps * gyro_noise;
-  const Vector3d accel_noise(normal_(rng_), normal_(rng_), normal_(rng_));
-  out.accel_mps2 =
-      ImuSpecificForce(s.q, s.qd, s.qdd, sc.imu_offset_m, config_.platform.gravity_mps2) +
-      sc.accel_bias_mps2 + sc.accel_noise_std_mps2 * accel_noise;
-  out.has_orientation = sc.has_orientation;
-  if (sc.has_orientation) {
-    const Vector3d n(normal_(rng_), normal_(rng_), normal_(rng_));
-    out.orientation_rpy_rad = s.q.tail<3>() + sc.orientation_noise_std_rad * n;
-  }
+  out.leg_length_m = r.leg_length_m;
+  out.gyro_radps = r.gyro_radps + (gyro_bias_radps_ - config_.sensors.gyro_bias_radps);
+  out.accel_mps2 = r.accel_mps2;
+  out.has_orientation = r.has_orientation;
+  out.orientation_rpy_rad = r.orientation_rpy_rad;
   return out;
 }
 

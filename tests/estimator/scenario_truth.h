@@ -2,13 +2,14 @@
 // Ground truth and noisy sensor readings along the paper's scenario (NOTES.md,
 // Section V.A), for the estimator tests. The motion is analytic (q, qd, qdd
 // exact), the applied leg forces follow from the model's InverseDynamics, and
-// the readings from the model's IK and IMU equations plus seeded noise, the
-// gyro bias and the 10-bit ADC. A stand-in until plant_sim's sensor model.
+// the readings come from plant_sim's SensorModel (seeded noise, biases, the
+// 10-bit ADC), the simulator's own sensor equations.
 #include <cstdint>
 #include <random>
 
 #include "stewart/config/stack_config.h"
 #include "stewart/estimator/ekf_types.h"
+#include "stewart/plant_sim/sensor_model.h"
 
 namespace stewart::test {
 
@@ -65,7 +66,8 @@ class ScenarioTruth {
   Vector6d d_ = Vector6d::Zero();
   Vector6d dd_ = Vector6d::Zero();
   Vector3d gyro_bias_radps_;
-  std::mt19937 rng_;
+  SensorModel sensor_model_;
+  std::mt19937 rng_;  // the disturbances
   std::normal_distribution<double> normal_{0.0, 1.0};
 };
 
