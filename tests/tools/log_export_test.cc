@@ -5,10 +5,13 @@
 #include <cstdlib>
 #include <fstream>
 #include <lcm/lcm-cpp.hpp>
+#include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "stewart/force_command_t.hpp"
+#include "stewart/safety_diagnostics_t.hpp"
 #include "stewart/state_t.hpp"
 
 namespace stewart {
@@ -54,6 +57,19 @@ TEST(LogExport, OneCsvPerChannel) {
       f.flags = k % 2;
       Append(&log, "T_CMD", f, 60 + k);
     }
+    safety_diagnostics_t d{};
+    d.utime = d.sample_utime = 7000;
+    d.num_position = 2;
+    d.position_names = {"x_upper", "leg0_max"};
+    d.h_position = {0.1, 0.2};
+    d.alpha_h_position = {0.1, 0.2};
+    d.w_position = {0.75, 0.25};
+    d.num_velocity = 1;
+    d.velocity_names = {"zd_upper"};
+    d.h_velocity = {0.01};
+    d.alpha_h_velocity = {0.02};
+    d.w_velocity = {1.0};
+    Append(&log, "T_DIAG", d, 70);
     lcm::LogEvent junk{};
     uint8_t bytes[4] = {1, 2, 3, 4};
     junk.channel = "T_OTHER";
@@ -72,6 +88,30 @@ TEST(LogExport, OneCsvPerChannel) {
   const auto cmd_rows = Lines(dir + "/T_CMD.csv");
   ASSERT_EQ(cmd_rows.size(), 6u);
   EXPECT_EQ(cmd_rows[5], "64,4000,4,4000,6,0,0,0,0,0,0");
+  // Diagnostics: the barrier weights by index, and which barrier each index is.
+  const auto diag = Lines(dir + "/T_DIAG.csv");
+  ASSERT_EQ(diag.size(), 2u);
+  std::vector<std::string> header, row;
+  for (const auto& [line, out] : {std::pair{diag[0], &header}, std::pair{diag[1], &row}}) {
+    std::stringstream in(line);
+    for (std::string cell; std::getline(in, cell, ',');) out->push_back(cell);
+  }
+  ASSERT_EQ(header.size(), row.size());
+  auto value = [&](const std::string& column) {
+    for (size_t i = 0; i < header.size(); ++i) {
+      if (header[i] == column) return row[i];
+    }
+    return std::string("missing");
+  };
+  EXPECT_EQ(value("w_position0_"), "0.75");
+  EXPECT_EQ(value("w_position1_"), "0.25");
+  EXPECT_EQ(value("w_velocity0_"), "1");
+  EXPECT_EQ(value("h_position1_"), "0.20000000000000001");
+  EXPECT_EQ(value("w_position23_"), "0");  // every column a config can have
+  const auto barriers = Lines(dir + "/T_DIAG.barriers.csv");
+  const std::vector<std::string> expected = {"group,index,name", "position,0,x_upper",
+                                             "position,1,leg0_max", "velocity,0,zd_upper"};
+  EXPECT_EQ(barriers, expected);
   std::ifstream other(dir + "/T_OTHER.csv");
   EXPECT_FALSE(other.good()) << "unknown types must be skipped, not exported";
 }

@@ -109,16 +109,39 @@ class ForceCommandWriter : public TypedWriter<force_command_t> {
 };
 
 class DiagnosticsWriter : public TypedWriter<safety_diagnostics_t> {
+ public:
+  // Which barrier each indexed column is: group, index, name.
+  std::string SidecarName() const override { return "barriers"; }
+  std::string Sidecar(const void* data, int size) const override {
+    safety_diagnostics_t m;
+    if (m.decode(data, 0, size) != size) return "";
+    std::string s = "group,index,name\n";
+    for (int i = 0; i < m.num_position; ++i) {
+      s += "position," + std::to_string(i) + "," + m.position_names[static_cast<size_t>(i)] + "\n";
+    }
+    for (int i = 0; i < m.num_velocity; ++i) {
+      s += "velocity," + std::to_string(i) + "," + m.velocity_names[static_cast<size_t>(i)] + "\n";
+    }
+    return s;
+  }
+
+ private:
   // Barrier arrays vary in length between configs; the CSV keeps the
-  // composed quantities, which every config has, plus the first barriers.
+  // composed quantities, which every config has, plus every barrier up to
+  // the most a config can have (safety/constraint_set.h: 2 per axis and 2
+  // per leg for position, 2 per axis for velocity); names in the sidecar.
+  static constexpr int kPositionColumns = 24;
+  static constexpr int kVelocityColumns = 12;
   std::string Columns() const override {
     return ",variant,correction_metric,active_case,infeasible,fallback_reason,h_pos,h_vel,psi_p,"
            "psi_v,mu_p,mu_v" +
            IndexedColumns("g_p", 6, "") + IndexedColumns("g_v", 6, "") +
            IndexedColumns("f_des", 6, "n") + IndexedColumns("f_safe", 6, "n") +
            IndexedColumns("mu_force", 6, "") + ",correction_norm_n,compute_ns,num_position," +
-           "num_velocity" + IndexedColumns("h_position", 8, "") +
-           IndexedColumns("h_velocity", 8, "");
+           "num_velocity" + IndexedColumns("h_position", kPositionColumns, "") +
+           IndexedColumns("h_velocity", kVelocityColumns, "") +
+           IndexedColumns("w_position", kPositionColumns, "") +
+           IndexedColumns("w_velocity", kVelocityColumns, "");
   }
   void Row(const safety_diagnostics_t& m, std::ostream& out) const override {
     out << ',' << int{m.variant} << ',' << int{m.correction_metric} << ',' << int{m.active_case}
@@ -131,8 +154,10 @@ class DiagnosticsWriter : public TypedWriter<safety_diagnostics_t> {
     Values(out, m.mu_force);
     out << ',' << m.correction_norm << ',' << m.compute_ns << ',' << m.num_position << ','
         << m.num_velocity;
-    Values(out, m.h_position, 8);
-    Values(out, m.h_velocity, 8);
+    Values(out, m.h_position, kPositionColumns);
+    Values(out, m.h_velocity, kVelocityColumns);
+    Values(out, m.w_position, kPositionColumns);
+    Values(out, m.w_velocity, kVelocityColumns);
   }
 };
 

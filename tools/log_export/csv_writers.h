@@ -15,6 +15,10 @@ class CsvChannelWriter {
   virtual std::string Header() const = 0;
   /// Returns false if the payload does not decode as this type.
   virtual bool WriteRow(const void* data, int size, std::ostream& out) const = 0;
+  /// A small side table from a channel's first message, written as
+  /// <channel>.<SidecarName()>.csv; "" when the type has none.
+  virtual std::string SidecarName() const { return ""; }
+  virtual std::string Sidecar(const void* /*data*/, int /*size*/) const { return ""; }
 };
 
 /// The writer for a payload, chosen by the type hash in its first 8 bytes;

@@ -48,6 +48,11 @@ int main(int argc, char** argv) {
       out.writer = writer;
       out.file.open(std::filesystem::path(out_dir) / (channel + ".csv"));
       out.file << std::setprecision(17) << "log_utime_us," << writer->Header() << '\n';
+      if (!writer->SidecarName().empty()) {
+        std::ofstream(std::filesystem::path(out_dir) /
+                      (channel + "." + writer->SidecarName() + ".csv"))
+            << writer->Sidecar(event->data, event->datalen);
+      }
       it = outputs.find(channel);
     }
     Output& out = it->second;

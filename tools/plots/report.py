@@ -141,6 +141,40 @@ def replay_section(run):
     return lines
 
 
+def constraint_activity(run, config, diag, dt):
+    """Time each constraint was active. The filter acts on the two composed
+    conditions; a composed condition's correction is attributed to its
+    barriers by their LSE weights w_i (they sum to 1): a barrier's active time
+    is the sum of w_i * dt over the steps whose case activates its group. Also
+    the steps where it dominated the composition (w_i >= 0.5)."""
+    lcm = config["lcm"]
+    name = lcm["channel_prefix"] + lcm["channels"]["safety_diagnostics"] + \
+        (lcm.get("channel_suffix") or "")
+    path = os.path.join(run, "csv", name + ".barriers.csv")
+    if not os.path.exists(path):
+        return []
+    with open(path) as f:
+        barriers = list(csv.DictReader(f))
+    case = diag["active_case"]
+    group_active = {"position": (case == 1) | (case == 3), "velocity": (case == 2) | (case == 3)}
+    lines = ["", "Time each constraint was active (its LSE weight's share of the active "
+             "composed condition; dominant: weight >= 0.5 while active):", "",
+             "| constraint | group | active time (s) | dominant steps |", "| --- | --- | --- | --- |"]
+    for b in barriers:
+        column = f"w_{b['group']}{b['index']}_"
+        if column not in diag:
+            continue
+        w = diag[column]
+        active = group_active[b["group"]]
+        time_s = float(np.sum(w[active])) * dt
+        dominant = int(np.sum(active & (w >= 0.5)))
+        if time_s > 0 or dominant:
+            lines.append(f"| {b['name']} | {b['group']} | {time_s:.2f} | {dominant} |")
+    if len(lines) == 5:
+        lines.append("| (none) | | 0 | 0 |")
+    return lines
+
+
 def main():
     run = sys.argv[1]
     with open(os.path.join(run, "config.yaml")) as f:
@@ -189,6 +223,7 @@ def main():
             n = int(np.sum(diag["active_case"] == code))
             if n:
                 lines.append(f"| {name} | {n} | {n * dt:.2f} |")
+        lines += constraint_activity(run, config, diag, dt)
         ns = diag["compute_ns"]
         lines += ["", f"Filter compute time per step: p50 {percentile(ns, 50) / 1e3:.2f} us, "
                   f"p99 {percentile(ns, 99) / 1e3:.2f} us, max {ns.max() / 1e3:.2f} us "
