@@ -178,6 +178,10 @@ void PlantSimNode::UpdateLatencyCounters() {
   health_.SetCounter("latency_p50_us", latency_.Percentile(0.50));
   health_.SetCounter("latency_p99_us", latency_.Percentile(0.99));
   health_.SetCounter("latency_max_us", latency_.max_us());
+  if (tick_jitter_.count() > 0) {  // real time only: how late each tick started
+    health_.SetCounter("tick_late_p99_us", tick_jitter_.Percentile(0.99));
+    health_.SetCounter("tick_late_max_us", tick_jitter_.max_us());
+  }
 }
 
 void PlantSimNode::ApplyRealTimeDecision() {
@@ -231,7 +235,9 @@ int PlantSimNode::RunRealTime() {
     // an overrun is a tick started more than one period after its deadline
     // (the simulator itself fell behind); a missed tick is one whose previous
     // sample got no command before this tick, so the stale one stays applied.
-    if (Clock::now() - deadline > period) health_.Count("overrun_ticks");
+    const Clock::duration late = Clock::now() - deadline;
+    tick_jitter_.Add(std::chrono::duration_cast<std::chrono::microseconds>(late).count());
+    if (late > period) health_.Count("overrun_ticks");
     if (tick_ > 0) {
       const int64_t previous_sample_utime = utime0_ + (tick_ - 1) * period_us_;
       if (last_applied_sample_utime_ < previous_sample_utime) health_.Count("missed_ticks");

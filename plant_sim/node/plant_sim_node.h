@@ -74,6 +74,7 @@ class PlantSimNode {
   std::array<std::chrono::steady_clock::time_point, kSentRing> sent_at_{};
   int64_t newest_timed_sample_utime_ = -1;
   LatencyHistogram latency_;
+  LatencyHistogram tick_jitter_;  // real time: tick start after its deadline
 };
 
 }  // namespace stewart

@@ -250,7 +250,8 @@ def main():
                       f"max {counters['latency_max_us']} us over "
                       f"{counters.get('answered_samples', '?')} answered samples.", ""]
         if counters:
-            keys = [k for k in ("missed_ticks", "overrun_ticks", "lockstep_resends",
+            keys = [k for k in ("missed_ticks", "overrun_ticks", "tick_late_p99_us",
+                                "tick_late_max_us", "lockstep_resends",
                                 "command_timeouts", "endstop_hits", "ticks") if k in counters]
             lines += ["Plant counters at the end (its last health message): " +
                       ", ".join(f"{k} {counters[k]}" for k in keys) +
