@@ -48,6 +48,12 @@ struct PlantRates {
 void PlantDerivative(const PlantModel& model, const PlantInputs& inputs, const PlantStateVector& x,
                      PlantRates* rates);
 
+/// The same, with rates->terms already evaluated at x's pose and velocity
+/// (EvaluateDynamics is most of the cost and depends on nothing else):
+/// actuator forces and qdd only.
+void PlantDerivativeGivenTerms(const PlantModel& model, const PlantInputs& inputs,
+                               const PlantStateVector& x, PlantRates* rates);
+
 /// T + V + end-stop spring energy (J): constant when F_leg is conservative
 /// (F = 0, no friction, no end-stop damping).
 double PlantMechanicalEnergy(const PlantModel& model, const Vector6d& q, const Vector6d& qd);
