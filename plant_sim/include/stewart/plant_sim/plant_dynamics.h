@@ -6,7 +6,8 @@
 //   qd'      = M^-1 (H F_leg - C qd - G),
 //   F_leg    = F_motor - b Ld + F_endstop(L, Ld) [+ F_lock(L, Ld)],  Ld = H^T qd
 //   F_motor' = (sat(F_cmd) - F_motor) / tau     if force_lag_s = tau > 0,
-//   F_motor  = sat(F_cmd) (held in the state, rate 0) otherwise.
+//   F_motor  = sat(F_cmd) (held in the state, rate 0) otherwise; Plant then
+//              integrates only q and qd (docs/simulation.md, "Integrator").
 #include <Eigen/Core>
 
 #include "stewart/config/platform_config.h"
