@@ -1,131 +1,159 @@
 #include "stewart/model/dynamics.h"
 
-#include <Eigen/Cholesky>
 #include <Eigen/LU>
 
+#include "leg_arrays.h"
+#include "stewart/model/fixed_size_ldlt.h"
 #include "stewart/model/rotation.h"
 
 namespace stewart {
 namespace {
+
+using internal::Cross;
+using internal::Dot;
+using internal::LegScalars;
+using internal::LegVectors;
+using internal::SumOfOuterProducts;
 
 // Each leg is reduced to two point-like terms at its platform joint a_i:
 //  - cylinder translation and both transverse rotations, 1/2 mu |nd|^2 with
 //    mu = m1 e1^2 + I1 + I2: the kinetic energy of a point of mass mu at the
 //    unit vector n_i;
 //  - rod translation, 1/2 m2 |d/dt (a_i - e2 n_i)|^2.
-// With v = J_a qd the joint velocity and J_a = [I, -[R p_i]x E], every term is
-// accumulated as a 3x3 "joint-space" inertia A_i and joint-space forces, then
-// mapped through J_a^T (see docs/model.md).
-struct JointSpaceTerms {
-  Matrix3d A;       // joint-space inertia (kg)
-  Vector3d f_bias;  // A-weighted bias acceleration (N)
-  Vector3d f_grav;  // gravity (N)
+// With v = J_a qd the joint velocity and J_a = [I, -[p]x E] (p = R p_i, {B}),
+// both give a 3x3 "joint-space" inertia at a_i (kg),
+//   A = m2 n n^T + c (I - n n^T) = c I + d n n^T,
+//   c = mu / L^2 + m2 s^2,  d = m2 - c,  s = 1 - e2 / L,
+// and joint-space bias and gravity forces (N), mapped through J_a^T
+// (docs/model.md, "Dynamics"). A is rank one in n, so no 3x3 product is needed.
+struct LegJointTerms {
+  LegScalars c;       // isotropic part of A (kg)
+  LegScalars d;       // n n^T part of A (kg)
+  LegVectors f_bias;  // joint-space bias force (N)
+  LegVectors f_grav;  // joint-space gravity force (N)
 };
 
-JointSpaceTerms LegJointTerms(const LegParams& leg, double g, const Vector3d& n, double length,
-                              const Vector3d& v, const Vector3d& a_bias) {
-  const double mu =
-      leg.cylinder_mass_kg * leg.cylinder_com_from_base_m * leg.cylinder_com_from_base_m +
-      leg.cylinder_inertia_kgm2 + leg.rod_inertia_kgm2;
-  const double m2 = leg.rod_mass_kg;
-  const double inv_l = 1.0 / length;
-  const double s = 1.0 - leg.rod_com_from_platform_m * inv_l;  // P2 = nn^T + s P_perp
+// The leg's mass constants, the same for every leg.
+struct LegMassConstants {
+  explicit LegMassConstants(const LegParams& leg)
+      : mu(leg.cylinder_mass_kg * leg.cylinder_com_from_base_m * leg.cylinder_com_from_base_m +
+           leg.cylinder_inertia_kgm2 + leg.rod_inertia_kgm2),
+        m2(leg.rod_mass_kg),
+        e2(leg.rod_com_from_platform_m),
+        m1_e1(leg.cylinder_mass_kg * leg.cylinder_com_from_base_m) {}
+  double mu;     // kg m^2
+  double m2;     // kg
+  double e2;     // m
+  double m1_e1;  // kg m
+};
 
-  const Matrix3d nnT = n * n.transpose();
-  const Matrix3d P_perp = Matrix3d::Identity() - nnT;
-
-  const double ld = n.dot(v);
-  const Vector3d nd = (v - n * ld) * inv_l;
-  // ndd with qdd = 0: [P_perp a - 2 Ld nd - n L |nd|^2] / L
-  const Vector3d P_perp_a = a_bias - n * n.dot(a_bias);
-  const Vector3d ndd = (P_perp_a - 2.0 * ld * nd) * inv_l - n * nd.squaredNorm();
-
-  JointSpaceTerms out;
-  out.A = m2 * nnT + (mu * inv_l * inv_l + m2 * s * s) * P_perp;
-  // mu J_n^T ndd  with J_n = P_perp J_a / L
-  const Vector3d f_mu = (mu * inv_l) * (ndd - n * n.dot(ndd));
-  // m2 J_r^T r_dd  with r = a - e2 n, J_r = P2 J_a
-  const Vector3d rdd = a_bias - leg.rod_com_from_platform_m * ndd;
-  const Vector3d f_rod = m2 * (n * n.dot(rdd) + s * (rdd - n * n.dot(rdd)));
-  out.f_bias = f_mu + f_rod;
-  // V = g (m1 e1 n_z + m2 (a - e2 n)_z)
-  const Vector3d ez = Vector3d::UnitZ();
-  const Vector3d P_perp_ez = ez - n * n.z();
-  out.f_grav = g * (leg.cylinder_mass_kg * leg.cylinder_com_from_base_m * inv_l * P_perp_ez +
-                    m2 * (n * n.z() + s * P_perp_ez));
+// n: unit leg vectors, inv_l = 1/L (1/m), v and a_bias: velocity (m/s) and
+// bias acceleration (m/s^2, the part with qdd = 0) of the platform joints,
+// all in {B}.
+LegJointTerms ComputeLegJointTerms(const LegMassConstants& k, double g, const LegVectors& n,
+                                   const LegScalars& inv_l, const LegVectors& v,
+                                   const LegVectors& a_bias) {
+  // Rod CoM Jacobian: J_r = (n n^T + s (I - n n^T)) J_a.
+  const LegScalars s = 1.0 - k.e2 * inv_l;
+  LegJointTerms out;
+  out.c = k.mu * inv_l.square() + k.m2 * s.square();
+  out.d = k.m2 - out.c;
+  const LegScalars ld = Dot(n, v);                                 // leg speed (m/s)
+  const LegVectors nd = (v - n.rowwise() * ld).rowwise() * inv_l;  // (I - n n^T) v / L (1/s)
+  // With ndd|qdd=0 = [(I - n n^T) a_bias - 2 Ld nd] / L - n |nd|^2 the two
+  // terms mu J_n^T ndd + m2 J_r^T (a_bias - e2 ndd) collect into
+  //   f_bias = A a_bias + m2 e2 |nd|^2 n + 2 Ld (m2 s e2 / L - mu / L^2) nd.
+  const LegScalars along_n = out.d * Dot(n, a_bias) + k.m2 * k.e2 * nd.square().colwise().sum();
+  const LegScalars along_nd = 2.0 * ld * inv_l * (k.m2 * k.e2 * s - k.mu * inv_l);
+  out.f_bias = a_bias.rowwise() * out.c + n.rowwise() * along_n + nd.rowwise() * along_nd;
+  // V = g (m1 e1 n_z + m2 (a - e2 n)_z):
+  //   f_grav = g [c_g e_z + (m2 - c_g) n_z n],  c_g = m1 e1 / L + m2 s.
+  const LegScalars c_g = k.m1_e1 * inv_l + k.m2 * s;
+  out.f_grav = n.rowwise() * (g * (k.m2 - c_g) * n.row(2));
+  out.f_grav.row(2) += g * c_g;
   return out;
 }
 
 }  // namespace
 
+// Sums over the point terms, in (translation, angular velocity) coordinates;
+// E is applied once at the end. For a point at offset p ({B}) with
+// joint-space inertia A = c I + d n n^T and u = p x n:
+//   M_tt += A
+//   N    += A [p]x         = c [p]x - d n u^T                 (M_tr = -N E)
+//   K    += [p]x^T A [p]x  = c (|p|^2 I - p p^T) + d u u^T    (M_rr = E^T K E)
+//   f_t  += f,  tau += p x f   (bias forces; likewise gravity)
+// The platform adds its CoM as such a point (A = m I) and its rotational
+// inertia R I_p R^T to K.
 void EvaluateDynamics(const PlatformParams& params, const Vector6d& q, const Vector6d& qd,
                       DynamicsTerms* terms) {
   const Vector3d t = q.head<3>();
-  const Vector3d rpy = q.tail<3>();
   const Vector3d td = qd.head<3>();
   const Vector3d rpyd = qd.tail<3>();
-  const Matrix3d R = RotationFromEuler(rpy);
-  const Matrix3d E = EulerRateMatrix(rpy);
+  const EulerAngleTrig trig(q.tail<3>());
+  const Matrix3d R = RotationFromEuler(trig);
+  const Matrix3d E = EulerRateMatrix(trig);
   const Vector3d omega = E * rpyd;
-  const Vector3d omegad_bias = EulerRateBiasAcceleration(rpy, rpyd);
+  const Vector3d omegad_bias = EulerRateBiasAcceleration(trig, rpyd);
   const double g = params.gravity_mps2;
 
-  // Accumulators in (translation, angular velocity) coordinates; E is applied
-  // once at the end: for a point at offset p, J = [I, -[p]x E].
-  Matrix3d M_tt = Matrix3d::Zero();
-  Matrix3d N = Matrix3d::Zero();                              // sum A [p]x       -> M_tr = -N E
-  Matrix3d K = Matrix3d::Zero();                              // sum [p]x^T A [p]x -> M_rr = E^T K E
-  Vector3d f_t = Vector3d::Zero(), tau = Vector3d::Zero();    // bias
-  Vector3d g_t = Vector3d::Zero(), g_tau = Vector3d::Zero();  // gravity
+  // Legs: geometry (p = R p_i, n, L, u = p x n), joint velocity and bias
+  // acceleration, then the joint-space terms.
+  const internal::LegArrays geometry = internal::ComputeLegArrays(params, R, t);
+  const LegVectors& p = geometry.offset;
+  const LegScalars& inv_l = geometry.inverse_length;
+  const LegVectors& n = geometry.unit;
+  const LegVectors u = Cross(p, n);
+  const LegVectors w = Cross(omega, p);  // omega x p
+  const LegVectors v = w.colwise() + td.array();
+  const LegVectors a_bias = Cross(omegad_bias, p) + Cross(omega, w);
+  const LegJointTerms legs =
+      ComputeLegJointTerms(LegMassConstants(params.leg), g, n, inv_l, v, a_bias);
+  terms->leg_length_m = geometry.length.transpose();
+  terms->H.topRows<3>() = n.matrix();
+  terms->H.bottomRows<3>().noalias() = E.transpose() * u.matrix();
 
-  auto accumulate_point = [&](const Vector3d& p, const Matrix3d& A, const Vector3d& f_bias,
-                              const Vector3d& f_grav) {
-    const Matrix3d S = Skew(p);
-    const Matrix3d AS = A * S;
-    M_tt += A;
-    N += AS;
-    K -= S * AS;  // S^T = -S
-    f_t += f_bias;
-    tau += p.cross(f_bias);
-    g_t += f_grav;
-    g_tau += p.cross(f_grav);
-  };
+  // Platform CoM and inertia.
+  const Vector3d c = R * params.platform_com_m;
+  const double m = params.platform_mass_kg;
+  const Vector3d w_c = omega.cross(c);
+  const Vector3d f_c = m * (omegad_bias.cross(c) + omega.cross(w_c));  // m a_bias at the CoM
+  const Vector3d g_c(0.0, 0.0, m * g);
+  const Matrix3d I_world = R * params.platform_inertia_kgm2.asDiagonal() * R.transpose();
 
-  // Platform: mass at its CoM, plus rotational inertia.
-  {
-    const Vector3d c = R * params.platform_com_m;
-    const double m = params.platform_mass_kg;
-    const Vector3d a_bias = omegad_bias.cross(c) + omega.cross(omega.cross(c));
-    accumulate_point(c, m * Matrix3d::Identity(), m * a_bias, Vector3d(0.0, 0.0, m * g));
-    const Matrix3d I_world = R * params.platform_inertia_kgm2.asDiagonal() * R.transpose();
-    K += I_world;
-    tau += I_world * omegad_bias + omega.cross(I_world * omega);
+  const LegVectors cp = p.rowwise() * legs.c;
+  const LegVectors dn = n.rowwise() * legs.d;
+  const LegVectors du = u.rowwise() * legs.d;
+  const double sum_c = m + legs.c.sum();
+  const Vector3d sum_cp = m * c + cp.matrix().rowwise().sum();
+  const double sum_c_pp = m * c.squaredNorm() + Dot(cp, p).sum();
+
+  Matrix3d M_tt = SumOfOuterProducts(dn, n);
+  M_tt.diagonal().array() += sum_c;
+  const Matrix3d N = Skew(sum_cp) - SumOfOuterProducts(dn, u);
+  Matrix3d K =
+      SumOfOuterProducts(du, u) - SumOfOuterProducts(cp, p) - m * c * c.transpose() + I_world;
+  K.diagonal().array() += sum_c_pp;
+
+  Matrix6d& M = terms->M;
+  M.topLeftCorner<3, 3>() = M_tt;
+  M.bottomLeftCorner<3, 3>().noalias() = -E.transpose() * N.transpose();  // M_tr^T
+  M.bottomRightCorner<3, 3>().noalias() = E.transpose() * (K * E);
+  // M is symmetric by construction; copying the lower triangle makes it so to
+  // the last bit (the sums round differently above and below the diagonal).
+  for (int j = 1; j < 6; ++j) {
+    for (int i = 0; i < j; ++i) M(i, j) = M(j, i);
   }
 
-  // Legs.
-  for (int i = 0; i < kNumLegs; ++i) {
-    const Vector3d p = R * params.platform_joints_m.col(i);
-    const Vector3d leg = t + p - params.base_joints_m.col(i);
-    const double length = leg.norm();
-    const Vector3d n = leg / length;
-    terms->leg_length_m(i) = length;
-    terms->H.block<3, 1>(0, i) = n;
-    terms->H.block<3, 1>(3, i) = E.transpose() * p.cross(n);
-    const Vector3d v = td + omega.cross(p);
-    const Vector3d a_bias = omegad_bias.cross(p) + omega.cross(omega.cross(p));
-    const JointSpaceTerms leg_terms = LegJointTerms(params.leg, g, n, length, v, a_bias);
-    accumulate_point(p, leg_terms.A, leg_terms.f_bias, leg_terms.f_grav);
-  }
-
-  const Matrix3d M_tr = -N * E;
-  terms->M.topLeftCorner<3, 3>() = M_tt;
-  terms->M.topRightCorner<3, 3>() = M_tr;
-  terms->M.bottomLeftCorner<3, 3>() = M_tr.transpose();
-  terms->M.bottomRightCorner<3, 3>() = E.transpose() * K * E;
+  const Vector3d f_t = f_c + legs.f_bias.matrix().rowwise().sum();
+  const Vector3d tau = c.cross(f_c) + Cross(p, legs.f_bias).matrix().rowwise().sum() +
+                       I_world * omegad_bias + omega.cross(I_world * omega);
+  const Vector3d g_t = g_c + legs.f_grav.matrix().rowwise().sum();
+  const Vector3d g_tau = c.cross(g_c) + Cross(p, legs.f_grav).matrix().rowwise().sum();
   terms->C_qd.head<3>() = f_t;
-  terms->C_qd.tail<3>() = E.transpose() * tau;
+  terms->C_qd.tail<3>().noalias() = E.transpose() * tau;
   terms->G.head<3>() = g_t;
-  terms->G.tail<3>() = E.transpose() * g_tau;
+  terms->G.tail<3>().noalias() = E.transpose() * g_tau;
 }
 
 DynamicsTerms EvaluateDynamics(const PlatformParams& params, const Vector6d& q,
@@ -136,7 +164,7 @@ DynamicsTerms EvaluateDynamics(const PlatformParams& params, const Vector6d& q,
 }
 
 Vector6d ForwardDynamics(const DynamicsTerms& terms, const Vector6d& force_n) {
-  return terms.M.llt().solve(terms.H * force_n - terms.C_qd - terms.G);
+  return Ldlt6d(terms.M).Solve(terms.H * force_n - terms.C_qd - terms.G);
 }
 
 Vector6d InverseDynamics(const DynamicsTerms& terms, const Vector6d& qdd) {

@@ -4,22 +4,18 @@
 #include <cmath>
 #include <limits>
 
+#include "leg_arrays.h"
 #include "stewart/model/rotation.h"
 
 namespace stewart {
 
 LegGeometry ComputeLegGeometry(const PlatformParams& params, const Vector6d& q) {
-  const Matrix3d R = RotationFromEuler(q.tail<3>());
-  const Vector3d t = q.head<3>();
+  const internal::LegArrays arrays =
+      internal::ComputeLegArrays(params, RotationFromEuler(q.tail<3>()), q.head<3>());
   LegGeometry legs;
-  for (int i = 0; i < kNumLegs; ++i) {
-    const Vector3d offset = R * params.platform_joints_m.col(i);
-    const Vector3d leg = t + offset - params.base_joints_m.col(i);
-    const double length = leg.norm();
-    legs.platform_offset_m.col(i) = offset;
-    legs.length_m(i) = length;
-    legs.unit_m.col(i) = leg / length;
-  }
+  legs.platform_offset_m = arrays.offset.matrix();
+  legs.unit_m = arrays.unit.matrix();
+  legs.length_m = arrays.length.transpose();
   return legs;
 }
 

@@ -12,6 +12,8 @@
 #include <cstdlib>
 #include <stdexcept>
 
+#include "stewart/plant_sim/serial_vector_kernels.h"
+
 namespace stewart {
 
 OdeMethod ParseOdeMethod(const std::string& name) {
@@ -116,6 +118,7 @@ OdeIntegrator::OdeIntegrator(const OdeOptions& options, int size, int num_roots,
   }
   m.y = N_VNew_Serial(size, m.context);
   if (m.y == nullptr) throw std::runtime_error("N_VNew_Serial failed");
+  InstallSerialVectorKernels(m.y);  // before any clone: the workspace inherits the kernels
   N_VConst(0.0, m.y);
   const bool erk = m.IsErk();
   if (erk) {

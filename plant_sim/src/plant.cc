@@ -17,11 +17,20 @@ constexpr int kNumRoots = 2 * kNumLegs;
 // chattering contact; far more than any real impact sequence in one tick.
 constexpr int kMaxRootStopsPerAdvance = 10000;
 
+// Without force lag F_motor has rate 0: integrating it would only add six
+// constants to every vector operation and to the error norm.
+constexpr int kMotionStateSize = 12;
+
+int OdeSizeFor(const ActuatorConfig& actuators) {
+  return actuators.force_lag_s > 0.0 ? kPlantStateSize : kMotionStateSize;
+}
+
 }  // namespace
 
 Plant::Plant(const PlantModel& model, const OdeOptions& ode_options)
     : model_(model),
-      integrator_(ode_options, kPlantStateSize, kNumRoots, &Plant::Rhs, &Plant::Roots, this) {}
+      ode_size_(OdeSizeFor(model.actuators)),
+      integrator_(ode_options, ode_size_, kNumRoots, &Plant::Rhs, &Plant::Roots, this) {}
 
 void Plant::Reset(double t_s, const Vector6d& q, const Vector6d& qd) {
   t_s_ = t_s;
@@ -79,8 +88,20 @@ void Plant::Advance(double dt_s) {
   t_s_ = t_end;  // the stop time is hit exactly; avoid any drift of the tick grid
 }
 
-const PlantRates& Plant::EvaluateRates() {
-  PlantDerivative(model_, inputs_, x_, &rates_);
+const PlantRates& Plant::EvaluateRates() { return UpdateRates(x_); }
+
+const PlantRates& Plant::UpdateRates(const PlantStateVector& x) {
+  // Exact equality: the cached values are those a new evaluation would give.
+  const bool same_motion =
+      rates_revision_ >= 0 && x.head<kMotionStateSize>() == rates_x_.head<kMotionStateSize>();
+  if (same_motion && rates_revision_ == inputs_revision_ &&
+      MotorForceOf(x) == MotorForceOf(rates_x_)) {
+    return rates_;
+  }
+  if (!same_motion) EvaluateDynamics(model_.platform, PoseOf(x), VelocityOf(x), &rates_.terms);
+  PlantDerivativeGivenTerms(model_, inputs_, x, &rates_);
+  rates_x_ = x;
+  rates_revision_ = inputs_revision_;
   return rates_;
 }
 
@@ -100,18 +121,34 @@ PlantCounters Plant::counters() const {
 
 int Plant::Rhs(double /*t*/, const double* y, double* y_dot, void* self) {
   auto* plant = static_cast<Plant*>(self);
-  const PlantStateVector x = Eigen::Map<const PlantStateVector>(y);
-  PlantDerivative(plant->model_, plant->inputs_, x, &plant->rates_);
-  if (!plant->rates_.x_dot.allFinite()) return 1;  // recoverable: retry a smaller step
-  Eigen::Map<PlantStateVector> x_dot(y_dot);
-  x_dot = plant->rates_.x_dot;
+  using MotionVector = Eigen::Matrix<double, kMotionStateSize, 1>;
+  const bool motion_only = plant->ode_size_ == kMotionStateSize;
+  PlantStateVector x;
+  if (motion_only) {
+    x << Eigen::Map<const MotionVector>(y), MotorForceOf(plant->x_);
+  } else {
+    x = Eigen::Map<const PlantStateVector>(y);
+  }
+  const PlantRates& rates = plant->UpdateRates(x);
+  if (!rates.x_dot.allFinite()) return 1;  // recoverable: retry a smaller step
+  if (motion_only) {
+    Eigen::Map<MotionVector> x_dot(y_dot);
+    x_dot = rates.x_dot.head<kMotionStateSize>();
+  } else {
+    Eigen::Map<PlantStateVector> x_dot(y_dot);
+    x_dot = rates.x_dot;
+  }
   return 0;
 }
 
 int Plant::Roots(double /*t*/, const double* y, double* g, void* self) {
   const auto* plant = static_cast<const Plant*>(self);
   const Vector6d q = Eigen::Map<const Vector6d>(y);
-  const Vector6d lengths = InverseKinematics(plant->model_.platform, q);
+  // ARKODE checks the roots right after evaluating f at the same state; the
+  // model's leg lengths are bit-identical to InverseKinematics.
+  const Vector6d lengths = plant->rates_revision_ >= 0 && q == plant->rates_x_.head<6>()
+                               ? plant->rates_.terms.leg_length_m
+                               : InverseKinematics(plant->model_.platform, q);
   const double l_min = plant->model_.actuators.min_length_m;
   const double l_max = l_min + plant->model_.actuators.stroke_m;
   Eigen::Map<Vector6d> g_low(g);

@@ -6,10 +6,14 @@ namespace stewart {
 
 void PlantDerivative(const PlantModel& model, const PlantInputs& inputs, const PlantStateVector& x,
                      PlantRates* rates) {
-  const Vector6d q = PoseOf(x);
+  EvaluateDynamics(model.platform, PoseOf(x), VelocityOf(x), &rates->terms);
+  PlantDerivativeGivenTerms(model, inputs, x, rates);
+}
+
+void PlantDerivativeGivenTerms(const PlantModel& model, const PlantInputs& inputs,
+                               const PlantStateVector& x, PlantRates* rates) {
   const Vector6d qd = VelocityOf(x);
-  DynamicsTerms& terms = rates->terms;
-  EvaluateDynamics(model.platform, q, qd, &terms);
+  const DynamicsTerms& terms = rates->terms;
   const Vector6d& leg_length_m = terms.leg_length_m;
   const Vector6d leg_speed_mps = terms.H.transpose() * qd;  // Ld = J_l qd, H = J_l^T
 

@@ -37,6 +37,18 @@ TEST(Dynamics, HIsTransposedLegJacobian) {
   }
 }
 
+// Bit for bit: plant_sim's root functions take the leg lengths of the last
+// model evaluation in place of InverseKinematics at the same q.
+TEST(Dynamics, LegLengthsAreExactlyInverseKinematics) {
+  const auto& p = DefaultConfig().platform;
+  std::mt19937 rng(18);
+  for (int n = 0; n < kStates; ++n) {
+    const Vector6d q = RandomPose(&rng);
+    const DynamicsTerms t = EvaluateDynamics(p, q, RandomVelocity(&rng));
+    for (int i = 0; i < kNumLegs; ++i) EXPECT_EQ(t.leg_length_m(i), InverseKinematics(p, q)(i));
+  }
+}
+
 Matrix6d MassMatrix(const PlatformParams& p, const Vector6d& q) {
   return EvaluateDynamics(p, q, Vector6d::Zero()).M;
 }

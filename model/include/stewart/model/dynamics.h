@@ -30,7 +30,8 @@ void EvaluateDynamics(const PlatformParams& params, const Vector6d& q, const Vec
                       DynamicsTerms* terms);
 DynamicsTerms EvaluateDynamics(const PlatformParams& params, const Vector6d& q, const Vector6d& qd);
 
-/// qdd = M^-1 (H F - C qd - G).
+/// qdd = M^-1 (H F - C qd - G), by the square-root-free Cholesky
+/// factorisation M = L D L^T (fixed_size_ldlt.h).
 Vector6d ForwardDynamics(const DynamicsTerms& terms, const Vector6d& force_n);
 
 /// The F that solves H F = M qdd + C qd + G (H is invertible away from

@@ -9,15 +9,26 @@
 
 namespace stewart {
 
+/// sin and cos of r = [phi theta psi], computed once: R, E and Edot rd all
+/// need them, and the sincos calls were a measurable part of a model
+/// evaluation when each function computed its own.
+struct EulerAngleTrig {
+  explicit EulerAngleTrig(const Vector3d& rpy_rad);
+  double sin_phi, cos_phi, sin_theta, cos_theta, sin_psi, cos_psi;
+};
+
 /// R = Rz(psi) Ry(theta) Rx(phi) from r = [phi theta psi] (rad).
 Matrix3d RotationFromEuler(const Vector3d& rpy_rad);
+Matrix3d RotationFromEuler(const EulerAngleTrig& trig);
 
 /// E(r): omega_B = E(r) * rd, with omega in {B} (rad/s).
 Matrix3d EulerRateMatrix(const Vector3d& rpy_rad);
+Matrix3d EulerRateMatrix(const EulerAngleTrig& trig);
 
 /// Edot(r, rd) * rd: the part of the angular acceleration (rad/s^2, {B})
 /// that does not depend on rdd.
 Vector3d EulerRateBiasAcceleration(const Vector3d& rpy_rad, const Vector3d& rpy_rate_radps);
+Vector3d EulerRateBiasAcceleration(const EulerAngleTrig& trig, const Vector3d& rpy_rate_radps);
 
 /// Inverse of RotationFromEuler for theta in (-pi/2, pi/2).
 Vector3d EulerFromRotation(const Matrix3d& R);

@@ -40,7 +40,8 @@ class Plant {
   const PlantModel& model() const { return model_; }
 
   /// Right-hand side at the current state with the inputs held now
-  /// (acceleration qdd, total leg forces, model terms).
+  /// (acceleration qdd, total leg forces, model terms). Free right after
+  /// Advance: the integrator's last evaluation was at this state.
   const PlantRates& EvaluateRates();
   /// True iff a leg is now beyond either stroke end (inside an end-stop).
   bool InEndStop() const;
@@ -49,16 +50,34 @@ class Plant {
  private:
   static int Rhs(double t, const double* y, double* y_dot, void* self);
   static int Roots(double t, const double* y, double* g, void* self);
-  void MarkDiscontinuity() { restart_pending_ = true; }
+  // A change of the held inputs or a stroke-end crossing: restart, and
+  // rates_ must be recomputed for the inputs (not for the model terms).
+  void MarkDiscontinuity() {
+    restart_pending_ = true;
+    ++inputs_revision_;
+  }
+  // f(x) with the held inputs into rates_, reusing what rates_ holds. ARKODE
+  // evaluates f at the end of every step (its next first stage), so after a
+  // tick rates_ holds f at x_: EvaluateRates then costs nothing, and the
+  // restart at the next tick, where only the force changes, keeps the model
+  // terms (M, C qd, G, H), which depend on q and qd alone; the root
+  // functions then reuse their leg lengths.
+  const PlantRates& UpdateRates(const PlantStateVector& x);
 
   PlantModel model_;
+  // Integrated values: q, qd and, only with a force lag, F_motor (without
+  // one, F_motor = sat(F_cmd) is an input and stays in x_ for output only).
+  int ode_size_;
   OdeIntegrator integrator_;
   PlantInputs inputs_;
   PlantStateVector x_ = PlantStateVector::Zero();
   double t_s_ = 0.0;
   bool restart_pending_ = true;
   long endstop_hits_ = 0;
-  PlantRates rates_;  // scratch of Rhs/EvaluateRates: no allocation per call
+  long inputs_revision_ = 0;
+  PlantRates rates_;  // f at rates_x_ under rates_revision_; no allocation per call
+  PlantStateVector rates_x_ = PlantStateVector::Zero();
+  long rates_revision_ = -1;  // -1: rates_ holds nothing yet
 };
 
 }  // namespace stewart

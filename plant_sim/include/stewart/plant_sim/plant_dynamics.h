@@ -6,7 +6,8 @@
 //   qd'      = M^-1 (H F_leg - C qd - G),
 //   F_leg    = F_motor - b Ld + F_endstop(L, Ld) [+ F_lock(L, Ld)],  Ld = H^T qd
 //   F_motor' = (sat(F_cmd) - F_motor) / tau     if force_lag_s = tau > 0,
-//   F_motor  = sat(F_cmd) (held in the state, rate 0) otherwise.
+//   F_motor  = sat(F_cmd) (held in the state, rate 0) otherwise; Plant then
+//              integrates only q and qd (docs/simulation.md, "Integrator").
 #include <Eigen/Core>
 
 #include "stewart/config/platform_config.h"
@@ -47,6 +48,12 @@ struct PlantRates {
 /// x_dot = f(x, inputs). No heap allocation.
 void PlantDerivative(const PlantModel& model, const PlantInputs& inputs, const PlantStateVector& x,
                      PlantRates* rates);
+
+/// The same, with rates->terms already evaluated at x's pose and velocity
+/// (EvaluateDynamics is most of the cost and depends on nothing else):
+/// actuator forces and qdd only.
+void PlantDerivativeGivenTerms(const PlantModel& model, const PlantInputs& inputs,
+                               const PlantStateVector& x, PlantRates* rates);
 
 /// T + V + end-stop spring energy (J): constant when F_leg is conservative
 /// (F = 0, no friction, no end-stop damping).
