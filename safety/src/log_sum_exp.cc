@@ -26,8 +26,7 @@ double ComposeLogSumExp(const double* alpha_h, int n, double k, double* weights)
   }
   // sum = 1 exactly when one term dominates: weights are final, ln(1) = 0.
   if (sum == 1.0) return m;
-  const double inv_sum = 1.0 / sum;
-  for (int i = 0; i < n; ++i) weights[i] *= inv_sum;
+  for (int i = 0; i < n; ++i) weights[i] /= sum;
   return m - std::log(sum) / k;
 }
 

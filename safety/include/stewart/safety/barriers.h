@@ -44,7 +44,7 @@ struct BarrierEvaluation {
 /// that nothing is evaluated twice per step: the factor of M, H^T qd, M qd
 /// and the two composed directions (g_p = -s_p ld, g_v = H^T M^-1 a_c).
 struct BarrierIntermediates {
-  Cholesky6 inertia;           ///< M = L_M L_M^T (valid iff inertia_valid)
+  Cholesky6 inertia;           ///< M = L D L^T (valid iff inertia_valid)
   bool inertia_valid = false;  ///< M was positive definite
   Vector6d leg_rate;           ///< ld = H^T qd (m/s)
   Vector6d m_qd;               ///< M qd

@@ -2,12 +2,13 @@
 // Fixed-size 6x6 factorisations for the filter's per-step path.
 //
 // Why not Eigen's LLT / PartialPivLU: at 6x6 both run their generic
-// (runtime-sized, blocked) kernels, ~200 ns for a factor and two solves on
-// the bench machine where these take ~50-80 ns (docs/performance.md). The
-// filter factors M once per step and, only when a constraint is active,
-// solves once with H. The loops below have compile-time bounds and are
-// unrolled; they are the textbook algorithms (square-root-free Cholesky;
-// Gaussian elimination with partial pivoting), so the accuracy is Eigen's
+// (runtime-sized, blocked) kernels. On the bench machine a factor of M and
+// two solves took ~220 ns with LLT and take ~60 ns here; a solve with H
+// ~175 ns with PartialPivLU, ~80 ns here (docs/performance.md). The filter
+// factors M once per step and, only when a constraint is active, solves
+// once with H. The loops below have compile-time bounds and are unrolled;
+// they are the textbook algorithms (square-root-free Cholesky; Gaussian
+// elimination with partial pivoting), so the accuracy is Eigen's
 // (tests/safety/linear_algebra6_test.cc).
 #include <cmath>
 #include <utility>
