@@ -62,6 +62,25 @@ void BM_ClosedFormCore(benchmark::State& state) {
 }
 BENCHMARK(BM_ClosedFormCore);
 
+// (a) on the states where a constraint acts only (about half of the set): the
+// only steps that solve with H, so the per-step worst case of the closed form.
+void BM_ClosedFormCoreActiveOnly(benchmark::State& state) {
+  SafetyFilter filter(Config().platform, Config().safety, Config().actuators);
+  std::vector<const Sample*> active;
+  SafetyDiagnostics d;
+  for (const Sample& s : Samples()) {
+    filter.StepWithTerms(s.terms, s.q, s.qd, s.f_des, &d);
+    if (d.filter_case != FilterCase::kNone) active.push_back(&s);
+  }
+  size_t i = 0;
+  for (auto _ : state) {
+    const Sample& s = *active[i++ % active.size()];
+    benchmark::DoNotOptimize(filter.StepWithTerms(s.terms, s.q, s.qd, s.f_des, &d));
+  }
+  state.counters["states"] = static_cast<double>(active.size());
+}
+BENCHMARK(BM_ClosedFormCoreActiveOnly);
+
 // (b) the full step including M, C qd, G, H.
 void BM_ClosedFormFullStep(benchmark::State& state) {
   SafetyFilter filter(Config().platform, Config().safety, Config().actuators);

@@ -1,6 +1,6 @@
 #include "stewart/safety/barriers.h"
 
-#include <Eigen/Cholesky>
+#include <cmath>
 
 #include "stewart/safety/log_sum_exp.h"
 
@@ -8,64 +8,99 @@ namespace stewart::safety {
 
 void EvaluateBarriers(const ConstraintSet& c, const Vector6d& q, const Vector6d& qd,
                       const DynamicsTerms& terms, const Vector6d& f_des, BarrierEvaluation* out) {
+  BarrierIntermediates unused;
+  EvaluateBarriers(c, q, qd, terms, f_des, 0.0, out, &unused);
+}
+
+void EvaluateBarriers(const ConstraintSet& c, const Vector6d& q, const Vector6d& qd,
+                      const DynamicsTerms& terms, const Vector6d& f_des, double leg_friction_nspm,
+                      BarrierEvaluation* out, BarrierIntermediates* x) {
   BarrierEvaluation& e = *out;
-  const Vector6d leg_rate = terms.H.transpose() * qd;  // ld = J_l qd, J_l = H^T
-  const Vector6d generalised_force = terms.H * f_des;  // H F_des
+  x->leg_rate.noalias() = terms.H.transpose() * qd;  // ld = J_l qd, J_l = H^T
+  // The conditions hold for what the legs really push: F + friction.
+  const Vector6d f_net = f_des + LegViscousFriction(leg_friction_nspm, x->leg_rate);
+  Vector6d generalised_force;  // H F_net
+  generalised_force.noalias() = terms.H * f_net;
+  x->m_qd.noalias() = terms.M * qd;
+  x->qd_m_qd = qd.dot(x->m_qd);
+  // One factor of M per step, shared by the velocity group and the
+  // acceleration metric (SafetyFilter).
+  x->inertia_valid = x->inertia.Compute(terms.M);
 
   if (c.num_position > 0) {
-    const double kinetic = 0.5 * qd.dot(terms.M * qd);
+    const double kinetic = 0.5 * x->qd_m_qd;
     // -qd^T (H F_des - G): the power term common to every position barrier.
     const double power = -qd.dot(generalised_force - terms.G);
     for (int i = 0; i < c.num_position; ++i) {
-      const PositionBarrierSpec& s = c.position[static_cast<size_t>(i)];
+      const size_t k = static_cast<size_t>(i);
+      const PositionBarrierSpec& s = c.position[k];
       const bool axis = s.source == PositionSource::kAxis;
       const double value = axis ? q(s.index) : terms.leg_length_m(s.index);
-      const double rate = axis ? qd(s.index) : leg_rate(s.index);
+      const double rate = axis ? qd(s.index) : x->leg_rate(s.index);
       const double h = s.sign * (value - s.limit);
-      e.h_position[static_cast<size_t>(i)] = -kinetic + s.alpha_e * h;
-      e.alpha_h_position[static_cast<size_t>(i)] = s.alpha * e.h_position[static_cast<size_t>(i)];
-      e.dh_position[static_cast<size_t>(i)] = power + s.alpha_e * s.sign * rate;
+      e.h_position[k] = -kinetic + s.alpha_e * h;
+      e.alpha_h_position[k] = s.alpha * e.h_position[k];
+      e.dh_position[k] = power + s.alpha_e * s.sign * rate;
     }
     e.h_pos = ComposeLogSumExp(e.alpha_h_position.data(), c.num_position, c.k_position,
                                e.w_position.data());
     double sum_alpha_w = 0.0;
     double psi = e.h_pos;
     for (int i = 0; i < c.num_position; ++i) {
-      const double alpha_w =
-          c.position[static_cast<size_t>(i)].alpha * e.w_position[static_cast<size_t>(i)];
+      const size_t k = static_cast<size_t>(i);
+      const double alpha_w = c.position[k].alpha * e.w_position[k];
       sum_alpha_w += alpha_w;
-      psi += alpha_w * e.dh_position[static_cast<size_t>(i)];
+      psi += alpha_w * e.dh_position[k];
     }
     e.psi_p = psi - c.position_margin;
-    e.g_p = -sum_alpha_w * leg_rate;
+    x->s_p = sum_alpha_w;
+    e.g_p = -sum_alpha_w * x->leg_rate;
   } else {
     e.h_pos = e.psi_p = 0.0;
+    x->s_p = 0.0;
     e.g_p.setZero();
   }
 
+  x->a_c.setZero();
   if (c.num_velocity > 0) {
-    const Eigen::LLT<Matrix6d> llt(terms.M);
-    const Vector6d qdd_des = llt.solve(generalised_force - terms.C_qd - terms.G);
+    if (!x->inertia_valid) {
+      // M^-1 does not exist: no velocity condition can be evaluated.
+      e.h_vel = e.psi_v = NAN;
+      e.g_v.setConstant(NAN);
+      x->m_inv_a_c.setConstant(NAN);
+      return;
+    }
     for (int i = 0; i < c.num_velocity; ++i) {
-      const VelocityBarrierSpec& s = c.velocity[static_cast<size_t>(i)];
-      e.h_velocity[static_cast<size_t>(i)] = s.sign * (qd(s.axis) - s.limit);
-      e.alpha_h_velocity[static_cast<size_t>(i)] = s.alpha_v * e.h_velocity[static_cast<size_t>(i)];
-      e.dh_velocity[static_cast<size_t>(i)] = s.sign * qdd_des(s.axis);
+      const size_t k = static_cast<size_t>(i);
+      const VelocityBarrierSpec& s = c.velocity[k];
+      e.h_velocity[k] = s.sign * (qd(s.axis) - s.limit);
+      e.alpha_h_velocity[k] = s.alpha_v * e.h_velocity[k];
     }
     e.h_vel = ComposeLogSumExp(e.alpha_h_velocity.data(), c.num_velocity, c.k_velocity,
                                e.w_velocity.data());
-    Vector6d a_c = Vector6d::Zero();  // sum_i alpha_i w_i dh_v,i/dqd
+    for (int i = 0; i < c.num_velocity; ++i) {
+      const size_t k = static_cast<size_t>(i);
+      const VelocityBarrierSpec& s = c.velocity[k];
+      x->a_c(s.axis) += s.alpha_v * e.w_velocity[k] * s.sign;
+    }
+    // qdd_des = M^-1 (H F_des - C qd - G) and M^-1 a_c in one pass.
+    Rhs6<2> rhs;
+    rhs.col(0) = generalised_force - terms.C_qd - terms.G;
+    rhs.col(1) = x->a_c;
+    x->inertia.SolveInPlace<2>(&rhs);
     double psi = e.h_vel;
     for (int i = 0; i < c.num_velocity; ++i) {
-      const VelocityBarrierSpec& s = c.velocity[static_cast<size_t>(i)];
-      const double alpha_w = s.alpha_v * e.w_velocity[static_cast<size_t>(i)];
-      a_c(s.axis) += alpha_w * s.sign;
-      psi += alpha_w * e.dh_velocity[static_cast<size_t>(i)];
+      const size_t k = static_cast<size_t>(i);
+      const VelocityBarrierSpec& s = c.velocity[k];
+      e.dh_velocity[k] = s.sign * rhs(s.axis, 0);
+      psi += s.alpha_v * e.w_velocity[k] * e.dh_velocity[k];
     }
     e.psi_v = psi - c.velocity_margin;
-    e.g_v = terms.H.transpose() * llt.solve(a_c);
+    x->m_inv_a_c = rhs.col(1);
+    e.g_v.noalias() = terms.H.transpose() * x->m_inv_a_c;
   } else {
     e.h_vel = e.psi_v = 0.0;
+    x->m_inv_a_c.setZero();
     e.g_v.setZero();
   }
 }

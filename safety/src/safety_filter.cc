@@ -1,28 +1,33 @@
 #include "stewart/safety/safety_filter.h"
 
-#include <Eigen/Cholesky>
-#include <Eigen/LU>
 #include <Eigen/QR>
 #include <chrono>
 #include <cmath>
 #include <stdexcept>
 
+#include "stewart/safety/linear_algebra6.h"
+
 namespace stewart::safety {
 namespace {
 
-bool TermsFinite(const DynamicsTerms& t) {
-  return t.M.allFinite() && t.C_qd.allFinite() && t.G.allFinite() && t.H.allFinite() &&
-         t.leg_length_m.allFinite();
+// x - x is 0 for a finite x and NaN for NaN or +-Inf, and a NaN survives a
+// sum: one comparison for all 96 numbers instead of a branch per entry.
+bool StateAndTermsFinite(const Vector6d& q, const Vector6d& qd, const DynamicsTerms& t) {
+  const double probe = (q - q).sum() + (qd - qd).sum() + (t.M - t.M).sum() + (t.H - t.H).sum() +
+                       (t.C_qd - t.C_qd).sum() + (t.G - t.G).sum() +
+                       (t.leg_length_m - t.leg_length_m).sum();
+  return probe == 0.0;
 }
 
 bool BarriersFinite(const BarrierEvaluation& b) {
-  return std::isfinite(b.psi_p) && std::isfinite(b.psi_v) && std::isfinite(b.h_pos) &&
-         std::isfinite(b.h_vel) && b.g_p.allFinite() && b.g_v.allFinite();
+  const double probe = (b.psi_p - b.psi_p) + (b.psi_v - b.psi_v) + (b.h_pos - b.h_pos) +
+                       (b.h_vel - b.h_vel) + (b.g_p - b.g_p).sum() + (b.g_v - b.g_v).sum();
+  return probe == 0.0;
 }
 
-// The two conditions in the metric's coordinates z: g~ = T^T g.
+// The two conditions in the metric's coordinates y = T^-1 F: g~ = T^T g.
 TwoConstraintProblem MakeProblem(const ConstraintSet& c, const BarrierEvaluation& b,
-                                 CorrectionMetric metric) {
+                                 const Matrix6d& map, CorrectionMetric metric) {
   TwoConstraintProblem p;
   p.psi_p = b.psi_p;
   p.psi_v = b.psi_v;
@@ -30,28 +35,20 @@ TwoConstraintProblem MakeProblem(const ConstraintSet& c, const BarrierEvaluation
     p.g_p = b.g_p;
     p.g_v = b.g_v;
   } else {
-    p.g_p.noalias() = b.metric_map.transpose() * b.g_p;
-    p.g_v.noalias() = b.metric_map.transpose() * b.g_v;
+    p.g_p.noalias() = map.transpose() * b.g_p;
+    p.g_v.noalias() = map.transpose() * b.g_v;
   }
   p.has_p = c.num_position > 0;
   p.has_v = c.num_velocity > 0;
   return p;
 }
 
-// T with T T^T = W^-1 = H^-1 M H^-T for the acceleration metric: T = H^-1 L_M.
-// Not finite when H is singular (the caller then falls back).
-void ComputeMetricMap(CorrectionMetric metric, const DynamicsTerms& terms, Matrix6d* map) {
-  if (metric == CorrectionMetric::kForce) {
-    map->setIdentity();
-    return;
-  }
-  const Eigen::LLT<Matrix6d> llt(terms.M);
-  const Eigen::PartialPivLU<Matrix6d> lu(terms.H);
-  if (llt.info() != Eigen::Success || !(std::fabs(lu.determinant()) > 0.0)) {
-    map->setConstant(NAN);
-    return;
-  }
-  *map = lu.solve(Matrix6d(llt.matrixL()));
+// T = H^-1 L_M given the factor of M; false (T NaN) when H is singular.
+bool AccelerationMetricMap(const Matrix6d& h, const Cholesky6& inertia, Matrix6d* map) {
+  *map = inertia.MatrixL();
+  if (SolvePartialPivot6(h, map)) return true;
+  map->setConstant(NAN);
+  return false;
 }
 
 FilterCase CaseFromMultipliers(double mu_p, double mu_v) {
@@ -94,6 +91,8 @@ void SafetyFilter::set_variant(SafetyVariant variant) {
 
 Vector6d SafetyFilter::Step(const Vector6d& q, const Vector6d& qd, const Vector6d& f_des,
                             SafetyDiagnostics* diagnostics) {
+  // The one clock read pair of a step: compute_ns covers the model terms and
+  // the filter (StepWithTerms is not timed).
   const auto start = std::chrono::steady_clock::now();
   if (q.allFinite() && qd.allFinite()) {
     EvaluateDynamics(platform_, q, qd, &terms_);
@@ -110,35 +109,37 @@ Vector6d SafetyFilter::Step(const Vector6d& q, const Vector6d& qd, const Vector6
 Vector6d SafetyFilter::StepWithTerms(const DynamicsTerms& terms, const Vector6d& q,
                                      const Vector6d& qd, const Vector6d& f_des,
                                      SafetyDiagnostics* d) const {
-  const auto start = std::chrono::steady_clock::now();
   d->variant = variant_;
   d->flags = 0;
   d->infeasible = false;
   d->mu_p = d->mu_v = 0.0;
   d->mu_force.setZero();
   d->f_des = f_des;
+  d->compute_ns = 0;
 
-  const bool state_valid = q.allFinite() && qd.allFinite() && TermsFinite(terms);
-  const bool input_valid =
-      state_valid && f_des.allFinite() && f_des.cwiseAbs().maxCoeff() <= kMaxInputForceN;
+  const bool state_valid = StateAndTermsFinite(q, qd, terms);
+  // NaN compares false: this also rejects non-finite entries.
+  const bool input_valid = state_valid && (f_des.array().abs() <= kMaxInputForceN).all();
   bool ok = input_valid;
+  BarrierIntermediates x;
   if (ok) {
-    // The conditions hold for what the legs really push: F + friction.
-    const Vector6d f_net_des =
-        f_des + LegViscousFriction(leg_friction_nspm_, terms.H.transpose() * qd);
-    EvaluateBarriers(constraints_, q, qd, terms, f_net_des, &d->barriers);
-    ComputeMetricMap(metric_, terms, &d->barriers.metric_map);
-    ok = BarriersFinite(d->barriers) && d->barriers.metric_map.allFinite();
+    EvaluateBarriers(constraints_, q, qd, terms, f_des, leg_friction_nspm_, &d->barriers, &x);
+    ok = BarriersFinite(d->barriers) && (metric_ == CorrectionMetric::kForce || x.inertia_valid);
   }
   if (ok) {
-    if (variant_ == SafetyVariant::kQpReference) {
-      SolveReference(d->barriers, f_des, d);
-    } else if (force_limits_) {
-      SolveForceLimited(terms, qd, d->barriers, f_des, d);
+    if (variant_ == SafetyVariant::kQpReference || force_limits_) {
+      // These pose the QP in y = T^-1 F, so they need T itself.
+      Matrix6d map;
+      ok = ComputeMetricMap(terms, x, &map);
+      if (ok && variant_ == SafetyVariant::kQpReference) {
+        SolveReference(terms, qd, x, map, d->barriers, f_des, d);
+      } else if (ok) {
+        SolveForceLimited(terms, qd, map, d->barriers, f_des, d);
+      }
     } else {
-      SolveUnlimited(d->barriers, f_des, d);
+      SolveUnlimited(terms, qd, x, d->barriers, f_des, d);
     }
-    ok = d->f_safe.allFinite();
+    ok = ok && d->f_safe.allFinite();
   }
   if (!ok) {
     // Last resort: nothing trustworthy to filter. Flagged, never F_des.
@@ -154,9 +155,6 @@ Vector6d SafetyFilter::StepWithTerms(const DynamicsTerms& terms, const Vector6d&
   d->correction_norm = correction.allFinite() ? correction.norm() : 0.0;
   if (!(d->correction_norm == 0.0)) d->flags |= kFlagFilterActive;
   if (d->infeasible) d->flags |= kFlagInfeasible;
-  d->compute_ns =
-      std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - start)
-          .count();
   return d->f_safe;
 }
 
@@ -184,35 +182,85 @@ Vector6d SafetyFilter::SafeStop(const DynamicsTerms& terms, const Vector6d& qd,
   return f;
 }
 
-void SafetyFilter::SolveUnlimited(const BarrierEvaluation& b, const Vector6d& f_des,
-                                  SafetyDiagnostics* d) const {
-  const TwoConstraintProblem problem = MakeProblem(constraints_, b, metric_);
+Matrix6d SafetyFilter::MetricMap(const DynamicsTerms& terms) const {
+  BarrierIntermediates x;
+  x.inertia_valid = x.inertia.Compute(terms.M);
+  Matrix6d map;
+  ComputeMetricMap(terms, x, &map);
+  return map;
+}
+
+bool SafetyFilter::ComputeMetricMap(const DynamicsTerms& terms, const BarrierIntermediates& x,
+                                    Matrix6d* map) const {
+  if (metric_ == CorrectionMetric::kForce) {
+    map->setIdentity();
+    return true;
+  }
+  if (!x.inertia_valid) {
+    map->setConstant(NAN);
+    return false;
+  }
+  return AccelerationMetricMap(terms.H, x.inertia, map);
+}
+
+void SafetyFilter::SolveUnlimited(const DynamicsTerms& terms, const Vector6d& qd,
+                                  const BarrierIntermediates& x, const BarrierEvaluation& b,
+                                  const Vector6d& f_des, SafetyDiagnostics* d) const {
+  // The case analysis needs the normals g~ = T^T g only through their dot
+  // products. Acceleration metric, T = H^-1 L_M, g_p = -s_p H^T qd,
+  // g_v = H^T M^-1 a_c: g~_p = -s_p L_M^T qd and g~_v = L_M^-1 a_c, so
+  //   g~_p.g~_p = s_p^2 qd^T M qd,  g~_p.g~_v = -s_p qd^T a_c,
+  //   g~_v.g~_v = a_c^T M^-1 a_c,
+  // and H cancels: no factor of H unless the correction is non-zero.
+  TwoConstraintGram gram;
+  gram.psi_p = b.psi_p;
+  gram.psi_v = b.psi_v;
+  gram.has_p = constraints_.num_position > 0;
+  gram.has_v = constraints_.num_velocity > 0;
+  if (metric_ == CorrectionMetric::kForce) {
+    gram.pp = b.g_p.squaredNorm();
+    gram.vv = b.g_v.squaredNorm();
+    gram.pv = b.g_p.dot(b.g_v);
+  } else {
+    gram.pp = x.s_p * x.s_p * x.qd_m_qd;
+    gram.vv = x.a_c.dot(x.m_inv_a_c);
+    gram.pv = -x.s_p * qd.dot(x.a_c);
+  }
   TwoConstraintSolution s =
-      variant_ == SafetyVariant::kPaperRule ? SolvePaperRule(problem) : SolveExactKkt(problem);
+      variant_ == SafetyVariant::kPaperRule ? SolvePaperRule(gram) : SolveExactKkt(gram);
   if (!s.feasible) {
-    s = SolveInfeasibleFallback(problem);
+    s = SolveInfeasibleFallback(gram);
     d->infeasible = true;
   }
   d->mu_p = s.mu_p;
   d->mu_v = s.mu_v;
   d->filter_case = s.filter_case;
-  d->f_safe = f_des + b.metric_map * (s.mu_p * problem.g_p + s.mu_v * problem.g_v);
+  if (metric_ == CorrectionMetric::kForce) {
+    d->f_safe = f_des + s.mu_p * b.g_p + s.mu_v * b.g_v;
+  } else if (s.mu_p == 0.0 && s.mu_v == 0.0) {
+    d->f_safe = f_des;
+  } else {
+    // F* - F_des = W^-1 (mu_p g_p + mu_v g_v) with W^-1 = H^-1 M H^-T:
+    // H (F* - F_des) = mu_v a_c - mu_p s_p M qd, one solve with H.
+    Vector6d correction = s.mu_v * x.a_c - (s.mu_p * x.s_p) * x.m_qd;
+    if (!SolvePartialPivot6(terms.H, &correction)) correction.setConstant(NAN);  // fallback
+    d->f_safe = f_des + correction;
+  }
 }
 
-bool SafetyFilter::BuildQp(const BarrierEvaluation& b, const Vector6d& f_des, ProjectionQp* qp,
-                           QpRows* rows) const {
+bool SafetyFilter::BuildQp(const Matrix6d& map, const BarrierEvaluation& b, const Vector6d& f_des,
+                           ProjectionQp* qp, QpRows* rows) const {
   QpRows unused;
   if (rows == nullptr) rows = &unused;
   const bool drop_velocity = rows->drop_velocity;
   *rows = QpRows{};
   rows->drop_velocity = drop_velocity;
-  const TwoConstraintProblem problem = MakeProblem(constraints_, b, metric_);
+  const TwoConstraintProblem problem = MakeProblem(constraints_, b, map, metric_);
   qp->m = 0;
   // y = T^-1 F; y0 = T^-1 F_des (F_des itself for the force metric).
-  if (metric_ == CorrectionMetric::kForce) {
-    qp->x0 = f_des;
-  } else {
-    qp->x0 = b.metric_map.partialPivLu().solve(f_des);
+  qp->x0 = f_des;
+  if (metric_ != CorrectionMetric::kForce && !SolvePartialPivot6(map, &qp->x0)) {
+    qp->x0.setConstant(NAN);
   }
   bool posable = true;
   auto add_cbf = [&](bool present, double psi, const Vector6d& g, int* row) {
@@ -234,9 +282,9 @@ bool SafetyFilter::BuildQp(const BarrierEvaluation& b, const Vector6d& f_des, Pr
   if (force_limits_) {
     // F_i = T_i y within [-F_max, F_max].
     for (int i = 0; i < kNumLegs; ++i) {
-      qp->a.row(qp->m) = b.metric_map.row(i);  // F_i >= -F_max
+      qp->a.row(qp->m) = map.row(i);  // F_i >= -F_max
       qp->b(qp->m++) = -force_limit_n_;
-      qp->a.row(qp->m) = -b.metric_map.row(i);  // F_i <= F_max
+      qp->a.row(qp->m) = -map.row(i);  // F_i <= F_max
       qp->b(qp->m++) = -force_limit_n_;
     }
   }
@@ -244,19 +292,19 @@ bool SafetyFilter::BuildQp(const BarrierEvaluation& b, const Vector6d& f_des, Pr
 }
 
 void SafetyFilter::SolveForceLimited(const DynamicsTerms& terms, const Vector6d& qd,
-                                     const BarrierEvaluation& b, const Vector6d& f_des,
-                                     SafetyDiagnostics* d) const {
+                                     const Matrix6d& map, const BarrierEvaluation& b,
+                                     const Vector6d& f_des, SafetyDiagnostics* d) const {
   ProjectionQp qp;
   ProjectionResult r;
   QpRows rows;
   r.status = ProjectionStatus::kInfeasible;
-  if (BuildQp(b, f_des, &qp, &rows)) r = SolveProjectionQp(qp);
+  if (BuildQp(map, b, f_des, &qp, &rows)) r = SolveProjectionQp(qp);
   if (r.status != ProjectionStatus::kOptimal) {
     // Keep the position condition and the limits, relax velocity.
     d->infeasible = true;
     rows.drop_velocity = true;
     r.status = ProjectionStatus::kInfeasible;
-    if (BuildQp(b, f_des, &qp, &rows)) r = SolveProjectionQp(qp);
+    if (BuildQp(map, b, f_des, &qp, &rows)) r = SolveProjectionQp(qp);
     if (r.status != ProjectionStatus::kOptimal) {
       d->filter_case = FilterCase::kFallback;
       d->flags |= kFlagFallback;
@@ -266,7 +314,7 @@ void SafetyFilter::SolveForceLimited(const DynamicsTerms& terms, const Vector6d&
   }
   // Map the multipliers of the unit-normal rows back to the conditions' own.
   // The rows hold g~/|g~| (BuildQp), so mu = mu_row / |g~|.
-  const TwoConstraintProblem problem = MakeProblem(constraints_, b, metric_);
+  const TwoConstraintProblem problem = MakeProblem(constraints_, b, map, metric_);
   if (rows.p >= 0) d->mu_p = r.mu(rows.p) / problem.g_p.norm();
   if (rows.v >= 0) d->mu_v = r.mu(rows.v) / problem.g_v.norm();
   if (force_limits_) {
@@ -275,31 +323,33 @@ void SafetyFilter::SolveForceLimited(const DynamicsTerms& terms, const Vector6d&
     }
     if ((d->mu_force.array() != 0.0).any()) d->flags |= kFlagForceLimited;
   }
-  d->f_safe = ForceFromQpSolution(b, r.x);
+  d->f_safe = ForceFromQpSolution(map, r.x);
   d->filter_case = d->infeasible ? FilterCase::kInfeasible : CaseFromMultipliers(d->mu_p, d->mu_v);
 }
 
-void SafetyFilter::SolveReference(const BarrierEvaluation& b, const Vector6d& f_des,
+void SafetyFilter::SolveReference(const DynamicsTerms& terms, const Vector6d& qd,
+                                  const BarrierIntermediates& x, const Matrix6d& map,
+                                  const BarrierEvaluation& b, const Vector6d& f_des,
                                   SafetyDiagnostics* d) const {
   ProjectionQp qp;
   Vector6d y = f_des;
-  const bool posable = BuildQp(b, f_des, &qp);
+  const bool posable = BuildQp(map, b, f_des, &qp);
   if (!posable || reference_->Solve(qp, &y) != ProjectionStatus::kOptimal) {
     // The reference has no answer: the closed form's documented fallback.
-    SolveUnlimited(b, f_des, d);
+    SolveUnlimited(terms, qd, x, b, f_des, d);
     d->infeasible = true;
     d->filter_case = FilterCase::kInfeasible;
     return;
   }
   // Multipliers from stationarity, y - y0 = mu_p g~_p + mu_v g~_v (least squares).
-  const TwoConstraintProblem problem = MakeProblem(constraints_, b, metric_);
+  const TwoConstraintProblem problem = MakeProblem(constraints_, b, map, metric_);
   Eigen::Matrix<double, 6, 2> g;
   g << problem.g_p, problem.g_v;
   const Eigen::Vector2d mu = g.colPivHouseholderQr().solve(y - qp.x0);
   d->mu_p = mu.allFinite() ? std::fmax(mu(0), 0.0) : 0.0;
   d->mu_v = mu.allFinite() ? std::fmax(mu(1), 0.0) : 0.0;
   d->filter_case = CaseFromMultipliers(d->mu_p, d->mu_v);
-  d->f_safe = ForceFromQpSolution(b, y);
+  d->f_safe = ForceFromQpSolution(map, y);
 }
 
 }  // namespace stewart::safety

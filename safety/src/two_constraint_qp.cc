@@ -16,16 +16,16 @@ struct Gram {
   bool p_zero, v_zero;
 };
 
-Gram MakeGram(const TwoConstraintProblem& pr) {
-  Gram g{pr.g_p.squaredNorm(), pr.g_v.squaredNorm(), pr.g_p.dot(pr.g_v), false, false};
+Gram MakeGram(const TwoConstraintGram& pr) {
+  Gram g{pr.pp, pr.vv, pr.pv, false, false};
   g.p_zero = !pr.has_p || !(g.pp > kZeroNormal * kZeroNormal);
   g.v_zero = !pr.has_v || !(g.vv > kZeroNormal * kZeroNormal);
   return g;
 }
 
 // Absent groups are satisfied by definition.
-double PsiP(const TwoConstraintProblem& pr) { return pr.has_p ? pr.psi_p : 0.0; }
-double PsiV(const TwoConstraintProblem& pr) { return pr.has_v ? pr.psi_v : 0.0; }
+double PsiP(const TwoConstraintGram& pr) { return pr.has_p ? pr.psi_p : 0.0; }
+double PsiV(const TwoConstraintGram& pr) { return pr.has_v ? pr.psi_v : 0.0; }
 
 TwoConstraintSolution Make(double mu_p, double mu_v, FilterCase c, bool feasible = true) {
   return {mu_p, mu_v, c, feasible};
@@ -33,7 +33,29 @@ TwoConstraintSolution Make(double mu_p, double mu_v, FilterCase c, bool feasible
 
 }  // namespace
 
+TwoConstraintGram GramOf(const TwoConstraintProblem& pr) {
+  TwoConstraintGram g;
+  g.psi_p = pr.psi_p;
+  g.psi_v = pr.psi_v;
+  g.pp = pr.g_p.squaredNorm();
+  g.vv = pr.g_v.squaredNorm();
+  g.pv = pr.g_p.dot(pr.g_v);
+  g.has_p = pr.has_p;
+  g.has_v = pr.has_v;
+  return g;
+}
+
 TwoConstraintSolution SolveExactKkt(const TwoConstraintProblem& pr) {
+  return SolveExactKkt(GramOf(pr));
+}
+TwoConstraintSolution SolvePaperRule(const TwoConstraintProblem& pr) {
+  return SolvePaperRule(GramOf(pr));
+}
+TwoConstraintSolution SolveInfeasibleFallback(const TwoConstraintProblem& pr) {
+  return SolveInfeasibleFallback(GramOf(pr));
+}
+
+TwoConstraintSolution SolveExactKkt(const TwoConstraintGram& pr) {
   const double psi_p = PsiP(pr), psi_v = PsiV(pr);
   // Case 1: F_des itself is feasible.
   if (psi_p >= 0.0 && psi_v >= 0.0) return Make(0, 0, FilterCase::kNone);
@@ -72,7 +94,7 @@ TwoConstraintSolution SolveExactKkt(const TwoConstraintProblem& pr) {
   return Make(0, 0, FilterCase::kInfeasible, false);
 }
 
-TwoConstraintSolution SolvePaperRule(const TwoConstraintProblem& pr) {
+TwoConstraintSolution SolvePaperRule(const TwoConstraintGram& pr) {
   const double psi_p = PsiP(pr), psi_v = PsiV(pr);
   const Gram g = MakeGram(pr);
   if (psi_p >= 0.0 && psi_v >= 0.0) return Make(0, 0, FilterCase::kNone);
@@ -93,7 +115,7 @@ TwoConstraintSolution SolvePaperRule(const TwoConstraintProblem& pr) {
               FilterCase::kBoth);
 }
 
-TwoConstraintSolution SolveInfeasibleFallback(const TwoConstraintProblem& pr) {
+TwoConstraintSolution SolveInfeasibleFallback(const TwoConstraintGram& pr) {
   const double psi_p = PsiP(pr), psi_v = PsiV(pr);
   const Gram g = MakeGram(pr);
   // Position first: on the slab of (anti)parallel normals, the point of the

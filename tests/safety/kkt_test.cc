@@ -32,7 +32,7 @@ void CheckKkt(bool force_limits, CorrectionMetric metric) {
     const double scale = f.norm() + f_des.norm() + 1.0;
     // Stationarity of (F - F_des)^T W (F - F_des): F - F_des = W^-1 (mu_p g_p + mu_v g_v -
     // mu_force), with W^-1 = T T^T, T = I for the force metric.
-    const Matrix6d& t = b.metric_map;
+    const Matrix6d t = filter.MetricMap(terms);
     if (metric == CorrectionMetric::kForce) {
       EXPECT_EQ(t, Matrix6d::Identity());
     } else {

@@ -67,6 +67,40 @@ TEST(LogSumExp, EqualInputsLoseExactlyLnNOverK) {
   EXPECT_NEAR(w[2], 0.25, 1e-15);
 }
 
+// The composition as written in the header, every exp() and log() called.
+double PlainLogSumExp(const double* alpha_h, int n, double k, double* weights) {
+  double m = alpha_h[0];
+  for (int i = 1; i < n; ++i) m = std::fmin(m, alpha_h[i]);
+  double sum = 0.0;
+  for (int i = 0; i < n; ++i) {
+    weights[i] = std::exp(-k * (alpha_h[i] - m));
+    sum += weights[i];
+  }
+  for (int i = 0; i < n; ++i) weights[i] /= sum;
+  return m - std::log(sum) / k;
+}
+
+TEST(LogSumExp, SkippedCallsGiveTheSameNumbers) {
+  // ComposeLogSumExp leaves out exp(0), the exp() that underflow to 0 and
+  // log(1): bit for bit the plain evaluation, for sharp and mild k.
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> value(-0.05, 0.05), logk(0.0, 7.0);
+  std::uniform_int_distribution<int> count(1, 15);
+  for (int trial = 0; trial < 20000; ++trial) {
+    const int n = count(rng);
+    const double k = std::pow(10.0, logk(rng));
+    std::array<double, 15> ah{}, w{}, w_plain{};
+    for (int i = 0; i < n; ++i) ah[static_cast<size_t>(i)] = value(rng);
+    if (trial % 3 == 0) ah[static_cast<size_t>(n - 1)] = ah[0];  // ties at the minimum
+    const double h_c = ComposeLogSumExp(ah.data(), n, k, w.data());
+    const double h_plain = PlainLogSumExp(ah.data(), n, k, w_plain.data());
+    ASSERT_EQ(h_c, h_plain) << "trial " << trial;
+    for (int i = 0; i < n; ++i) {
+      ASSERT_EQ(w[static_cast<size_t>(i)], w_plain[static_cast<size_t>(i)]) << "trial " << trial;
+    }
+  }
+}
+
 TEST(LogSumExp, NanPropagatesToBeRejected) {
   const std::array<double, 2> ah = {0.3, NAN};
   std::array<double, 2> w{};

@@ -44,10 +44,11 @@ void Sweep(ReferenceQpSolver* reference, bool force_limits, CorrectionMetric met
     ++cases[static_cast<size_t>(d.filter_case)];
     ProjectionQp qp;
     Vector6d y_ref = f_des;
-    const bool posable = filter.BuildQp(d.barriers, f_des, &qp);
+    const Matrix6d t = filter.MetricMap(terms);
+    const bool posable = filter.BuildQp(t, d.barriers, f_des, &qp);
     const ProjectionStatus status =
         posable ? reference->Solve(qp, &y_ref) : ProjectionStatus::kInfeasible;
-    const Vector6d f_ref = SafetyFilter::ForceFromQpSolution(d.barriers, y_ref);
+    const Vector6d f_ref = SafetyFilter::ForceFromQpSolution(t, y_ref);
     if (d.infeasible) {
       // Both must agree that there is no solution.
       EXPECT_NE(status, ProjectionStatus::kOptimal) << "sample " << n;

@@ -100,6 +100,20 @@ TEST(DiagnosticsMessage, CarriesEveryFilterQuantity) {
   EXPECT_GE(msg.psi_v + g_v.dot(f_safe - f_des), -1e-12);
 }
 
+TEST(DiagnosticsMessage, ComputeNsIsTheTimeOfTheFullStep) {
+  // Step reads the clock once around the model terms and the filter;
+  // StepWithTerms (terms given, e.g. the benches and tests) is not timed.
+  SafetyFilter filter(Config().platform, Config().safety, Config().actuators);
+  const Step s = ActiveStep();
+  SafetyDiagnostics d;
+  filter.Step(s.q, s.qd, s.f_des, &d);
+  EXPECT_GT(d.compute_ns, 0);
+  EXPECT_LT(d.compute_ns, 1000000000);
+  const DynamicsTerms t = EvaluateDynamics(Config().platform, s.q, s.qd);
+  filter.StepWithTerms(t, s.q, s.qd, s.f_des, &d);
+  EXPECT_EQ(d.compute_ns, 0);
+}
+
 std::string RunTool(const std::string& input, const std::string& args) {
   const std::string in_path = ::testing::TempDir() + "safety_tool_in.jsonl";
   std::ofstream(in_path) << input;

@@ -17,6 +17,7 @@
 
 #include "stewart/model/dynamics.h"
 #include "stewart/safety/constraint_set.h"
+#include "stewart/safety/linear_algebra6.h"
 
 namespace stewart::safety {
 
@@ -37,16 +38,33 @@ struct BarrierEvaluation {
   double psi_v = 0.0;               ///< Psi_v(F_des) - velocity robust margin (m/s^2)
   Vector6d g_p = Vector6d::Zero();  ///< dPsi_p/dF (W/N = m/s)
   Vector6d g_v = Vector6d::Zero();  ///< dPsi_v/dF (m/s^2 per N)
-  /// T of the correction metric (SafetyFilter; docs/safety.md): with
-  /// F = T y the cost (F - F_des)^T W (F - F_des) is ||y - y_des||^2, W^-1 = T T^T.
-  /// Identity for the force metric; H^-1 L_M (M = L_M L_M^T) for the
-  /// acceleration metric.
-  Matrix6d metric_map = Matrix6d::Identity();
+};
+
+/// What EvaluateBarriers computes on the way and the filter needs again, so
+/// that nothing is evaluated twice per step: the factor of M, H^T qd, M qd
+/// and the two composed directions (g_p = -s_p ld, g_v = H^T M^-1 a_c).
+struct BarrierIntermediates {
+  Cholesky6 inertia;           ///< M = L D L^T (valid iff inertia_valid)
+  bool inertia_valid = false;  ///< M was positive definite
+  Vector6d leg_rate;           ///< ld = H^T qd (m/s)
+  Vector6d m_qd;               ///< M qd
+  double qd_m_qd = 0.0;        ///< qd^T M qd = twice the kinetic energy (J)
+  double s_p = 0.0;            ///< sum_i alpha_i w_i of the position group (1/s)
+  Vector6d a_c;                ///< sum_i alpha_i w_i dh_v,i/dqd of the velocity group
+  Vector6d m_inv_a_c;          ///< M^-1 a_c (only with velocity barriers)
 };
 
 /// Evaluates every barrier and the two composed conditions at (q, qd, F_des)
 /// from the model terms at (q, qd). No heap allocation.
 void EvaluateBarriers(const ConstraintSet& constraints, const Vector6d& q, const Vector6d& qd,
                       const DynamicsTerms& terms, const Vector6d& f_des, BarrierEvaluation* out);
+
+/// The same, with the conditions evaluated at the net force the legs push,
+/// F_des + LegViscousFriction(leg_friction_nspm, H^T qd), and the
+/// intermediates returned. Psi is NaN (so the caller rejects the step) when
+/// velocity barriers exist and M is not positive definite.
+void EvaluateBarriers(const ConstraintSet& constraints, const Vector6d& q, const Vector6d& qd,
+                      const DynamicsTerms& terms, const Vector6d& f_des, double leg_friction_nspm,
+                      BarrierEvaluation* out, BarrierIntermediates* intermediates);
 
 }  // namespace stewart::safety

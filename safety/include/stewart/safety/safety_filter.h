@@ -32,11 +32,14 @@ class SafetyFilter {
                const ActuatorConfig& actuators, ReferenceQpSolver* reference = nullptr);
 
   /// Full step: evaluates the model terms at (q, qd), then StepWithTerms.
-  /// Output is always finite; see diagnostics->flags.
+  /// Output is always finite; see diagnostics->flags. diagnostics->compute_ns
+  /// is the wall time of this whole call (model terms included).
   Vector6d Step(const Vector6d& q, const Vector6d& qd, const Vector6d& f_des,
                 SafetyDiagnostics* diagnostics);
 
   /// The filter given the model terms at (q, qd) (from EvaluateDynamics).
+  /// Not timed: diagnostics->compute_ns is set to 0 (Step times the step;
+  /// a clock read costs ~10 % of this call).
   Vector6d StepWithTerms(const DynamicsTerms& terms, const Vector6d& q, const Vector6d& qd,
                          const Vector6d& f_des, SafetyDiagnostics* diagnostics) const;
 
@@ -45,8 +48,17 @@ class SafetyFilter {
   /// force if the state itself is not finite.
   Vector6d SafeStopCommand(const Vector6d& q, const Vector6d& qd, SafetyDiagnostics* diagnostics);
 
+  /// T of the correction metric at these model terms (docs/safety.md): with
+  /// F = T y the cost (F - F_des)^T W (F - F_des) is ||y - y_des||^2, and
+  /// W^-1 = T T^T. Identity for the force metric; H^-1 L_M (M = L_M L_M^T)
+  /// for the acceleration metric, NaN there when M is not positive definite
+  /// or H is singular. The unlimited closed form never forms T (it works
+  /// with the Gram matrix of T^T g_p, T^T g_v, which needs no H^-1); the
+  /// force-limited variant and the QP reference compute it per step.
+  Matrix6d MetricMap(const DynamicsTerms& terms) const;
+
   /// The QP the filter solves at this step, as posed to the reference solver:
-  /// in the metric's coordinates y = T^-1 F (T = barriers.metric_map, so
+  /// in the metric's coordinates y = T^-1 F (T = MetricMap(terms), so
   /// ||y - y0||^2 is the metric's cost; y = F for the force metric), CBF rows
   /// scaled to unit normals, box rows when force limits are on. Map a
   /// solution back with ForceFromQpSolution.
@@ -57,12 +69,12 @@ class SafetyFilter {
     int box = 0;                 ///< first force-limit row (lower, upper per leg)
     bool drop_velocity = false;  ///< in: leave the velocity condition out
   };
-  bool BuildQp(const BarrierEvaluation& barriers, const Vector6d& f_des, ProjectionQp* qp,
-               QpRows* rows = nullptr) const;
+  bool BuildQp(const Matrix6d& metric_map, const BarrierEvaluation& barriers, const Vector6d& f_des,
+               ProjectionQp* qp, QpRows* rows = nullptr) const;
 
   /// F = T y for a solution y of the QP from BuildQp.
-  static Vector6d ForceFromQpSolution(const BarrierEvaluation& barriers, const Vector6d& y) {
-    return barriers.metric_map * y;
+  static Vector6d ForceFromQpSolution(const Matrix6d& metric_map, const Vector6d& y) {
+    return metric_map * y;
   }
 
   void set_variant(SafetyVariant variant);
@@ -76,11 +88,16 @@ class SafetyFilter {
 
  private:
   Vector6d SafeStop(const DynamicsTerms& terms, const Vector6d& qd, bool terms_valid) const;
-  void SolveUnlimited(const BarrierEvaluation& b, const Vector6d& f_des,
+  bool ComputeMetricMap(const DynamicsTerms& terms, const BarrierIntermediates& x,
+                        Matrix6d* map) const;
+  void SolveUnlimited(const DynamicsTerms& terms, const Vector6d& qd, const BarrierIntermediates& x,
+                      const BarrierEvaluation& b, const Vector6d& f_des,
                       SafetyDiagnostics* d) const;
-  void SolveForceLimited(const DynamicsTerms& terms, const Vector6d& qd, const BarrierEvaluation& b,
-                         const Vector6d& f_des, SafetyDiagnostics* d) const;
-  void SolveReference(const BarrierEvaluation& b, const Vector6d& f_des,
+  void SolveForceLimited(const DynamicsTerms& terms, const Vector6d& qd, const Matrix6d& map,
+                         const BarrierEvaluation& b, const Vector6d& f_des,
+                         SafetyDiagnostics* d) const;
+  void SolveReference(const DynamicsTerms& terms, const Vector6d& qd, const BarrierIntermediates& x,
+                      const Matrix6d& map, const BarrierEvaluation& b, const Vector6d& f_des,
                       SafetyDiagnostics* d) const;
 
   PlatformParams platform_;

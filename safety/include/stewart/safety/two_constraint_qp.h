@@ -30,6 +30,18 @@ struct TwoConstraintProblem {
   bool has_p = false, has_v = false;
 };
 
+/// The same problem by its Gram matrix: the case analysis needs the normals
+/// only through their dot products, and the filter gets these in the
+/// acceleration metric without forming the normals (docs/safety.md).
+struct TwoConstraintGram {
+  double psi_p = 0.0, psi_v = 0.0;
+  double pp = 0.0, vv = 0.0, pv = 0.0;  ///< g_p.g_p, g_v.g_v, g_p.g_v
+  bool has_p = false, has_v = false;
+};
+
+/// psi, the dot products of g_p, g_v and has_* of `problem`.
+TwoConstraintGram GramOf(const TwoConstraintProblem& problem);
+
 struct TwoConstraintSolution {
   double mu_p = 0.0, mu_v = 0.0;
   FilterCase filter_case = FilterCase::kNone;
@@ -45,16 +57,19 @@ constexpr double kParallelSin2 = 1e-12;
 
 /// Exact KKT case analysis (cases 1-5 of NOTES.md).
 TwoConstraintSolution SolveExactKkt(const TwoConstraintProblem& problem);
+TwoConstraintSolution SolveExactKkt(const TwoConstraintGram& gram);
 
 /// The paper's literal Theorem 1: the case is chosen by the signs of psi_p,
 /// psi_v at F_des alone, and its formula applied without the validity check.
 /// Not the QP solution in general (NOTES.md); kept to show the difference.
 /// Degenerate normals still give a defined (infeasible) answer.
 TwoConstraintSolution SolvePaperRule(const TwoConstraintProblem& problem);
+TwoConstraintSolution SolvePaperRule(const TwoConstraintGram& gram);
 
 /// Lexicographic fallback for an infeasible problem: satisfy the position
 /// condition with the least correction (relaxing the velocity one), else the
 /// velocity condition alone; `feasible` stays false.
 TwoConstraintSolution SolveInfeasibleFallback(const TwoConstraintProblem& problem);
+TwoConstraintSolution SolveInfeasibleFallback(const TwoConstraintGram& gram);
 
 }  // namespace stewart::safety
