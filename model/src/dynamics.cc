@@ -1,9 +1,9 @@
 #include "stewart/model/dynamics.h"
 
-#include <Eigen/LU>
+#include <cmath>
 
 #include "leg_arrays.h"
-#include "stewart/model/fixed_size_ldlt.h"
+#include "stewart/model/linear_algebra6.h"
 #include "stewart/model/rotation.h"
 
 namespace stewart {
@@ -164,11 +164,15 @@ DynamicsTerms EvaluateDynamics(const PlatformParams& params, const Vector6d& q,
 }
 
 Vector6d ForwardDynamics(const DynamicsTerms& terms, const Vector6d& force_n) {
-  return Ldlt6d(terms.M).Solve(terms.H * force_n - terms.C_qd - terms.G);
+  Cholesky6 inertia;
+  if (!inertia.Compute(terms.M)) return Vector6d::Constant(NAN);
+  return inertia.Solve<1>(terms.H * force_n - terms.C_qd - terms.G);
 }
 
 Vector6d InverseDynamics(const DynamicsTerms& terms, const Vector6d& qdd) {
-  return terms.H.partialPivLu().solve(terms.M * qdd + terms.C_qd + terms.G);
+  Vector6d force_n = terms.M * qdd + terms.C_qd + terms.G;
+  if (!SolvePartialPivot6(terms.H, &force_n)) return Vector6d::Constant(NAN);
+  return force_n;
 }
 
 double KineticEnergy(const DynamicsTerms& terms, const Vector6d& qd) {

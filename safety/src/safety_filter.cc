@@ -5,7 +5,7 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "stewart/safety/linear_algebra6.h"
+#include "stewart/model/linear_algebra6.h"
 
 namespace stewart::safety {
 namespace {

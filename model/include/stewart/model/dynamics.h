@@ -31,11 +31,14 @@ void EvaluateDynamics(const PlatformParams& params, const Vector6d& q, const Vec
 DynamicsTerms EvaluateDynamics(const PlatformParams& params, const Vector6d& q, const Vector6d& qd);
 
 /// qdd = M^-1 (H F - C qd - G), by the square-root-free Cholesky
-/// factorisation M = L D L^T (fixed_size_ldlt.h).
+/// factorisation M = L D L^T (linear_algebra6.h). NaN when M is not
+/// positive definite (non-finite terms).
 Vector6d ForwardDynamics(const DynamicsTerms& terms, const Vector6d& force_n);
 
-/// The F that solves H F = M qdd + C qd + G (H is invertible away from
-/// singular poses; a least-squares answer is returned there).
+/// The F that solves H F = M qdd + C qd + G, by Gaussian elimination with
+/// partial pivoting (linear_algebra6.h). H is invertible away from singular
+/// poses; NaN where it is not (callers check: the controller rejects a
+/// non-finite force, the filter falls back).
 Vector6d InverseDynamics(const DynamicsTerms& terms, const Vector6d& qdd);
 
 /// Viscous friction of the legs' lead screws, as leg forces (N):

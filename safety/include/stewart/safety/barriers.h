@@ -17,7 +17,7 @@
 
 #include "stewart/model/dynamics.h"
 #include "stewart/safety/constraint_set.h"
-#include "stewart/safety/linear_algebra6.h"
+#include "stewart/model/linear_algebra6.h"
 
 namespace stewart::safety {
 

@@ -1,21 +1,23 @@
 #pragma once
-// Fixed-size 6x6 factorisations for the filter's per-step path.
+// Fixed-size 6x6 factorisations for the hot paths of every process: the
+// mass matrix M (ForwardDynamics at every right-hand side of the simulator,
+// the filter's barriers and metric, the estimator's prediction) and the
+// force map H (InverseDynamics, the filter's F* when a constraint acts).
 //
 // Why not Eigen's LLT / PartialPivLU: at 6x6 both run their generic
 // (runtime-sized, blocked) kernels. On the bench machine a factor of M and
 // two solves took ~220 ns with LLT and take ~60 ns here; a solve with H
-// ~175 ns with PartialPivLU, ~80 ns here (docs/performance.md). The filter
-// factors M once per step and, only when a constraint is active, solves
-// once with H. The loops below have compile-time bounds and are unrolled;
-// they are the textbook algorithms (square-root-free Cholesky; Gaussian
-// elimination with partial pivoting), so the accuracy is Eigen's
-// (tests/safety/linear_algebra6_test.cc).
+// ~175 ns with PartialPivLU, ~80 ns here (docs/performance.md). The loops
+// below have compile-time bounds and are unrolled; they are the textbook
+// algorithms (square-root-free Cholesky L D L^T, one division and no square
+// root per column; Gaussian elimination with partial pivoting), so the
+// accuracy is Eigen's (tests/model/linear_algebra6_test.cc).
 #include <cmath>
 #include <utility>
 
 #include "stewart/model/types.h"
 
-namespace stewart::safety {
+namespace stewart {
 
 /// Right-hand sides of Cholesky6::SolveInPlace: several are stored row-major
 /// so that one SIMD operation updates a row of all of them.
@@ -148,4 +150,4 @@ bool SolvePartialPivot6(Matrix6d a, Eigen::Matrix<double, 6, Cols>* b) {
   return true;
 }
 
-}  // namespace stewart::safety
+}  // namespace stewart

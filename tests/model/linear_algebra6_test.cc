@@ -1,7 +1,7 @@
-// The filter's fixed-size 6x6 factorisations (linear_algebra6.h) against
-// Eigen's LLT and PartialPivLU, on the model's M and H and on random
-// matrices of wide conditioning, plus the failure reports.
-#include "stewart/safety/linear_algebra6.h"
+// The fixed-size 6x6 factorisations (linear_algebra6.h) against Eigen's LLT
+// and PartialPivLU, on the model's M and H and on random matrices of wide
+// conditioning, plus the failure reports.
+#include "stewart/model/linear_algebra6.h"
 
 #include <gtest/gtest.h>
 
@@ -10,9 +10,10 @@
 #include <cmath>
 #include <limits>
 
-#include "safety_test_support.h"
+#include "stewart/model/dynamics.h"
+#include "test_states.h"
 
-namespace stewart::safety::test {
+namespace stewart::test {
 namespace {
 
 // Random matrix with singular values spread over `decades` decades.
@@ -39,7 +40,10 @@ Vector6d RandomVector(std::mt19937* rng) {
 // Backward-stable solvers agree to ~cond * eps.
 void ExpectCholeskyMatchesEigen(const Matrix6d& a, const Vector6d& b, double cond) {
   Cholesky6 chol;
-  ASSERT_TRUE(chol.Compute(a));
+  // Only the lower triangle is read, as by Eigen::LLT.
+  Matrix6d lower_only = a;
+  lower_only.triangularView<Eigen::StrictlyUpper>().setConstant(1e300);
+  ASSERT_TRUE(chol.Compute(lower_only));
   const Eigen::LLT<Matrix6d> llt(a);
   ASSERT_EQ(llt.info(), Eigen::Success);
   const Matrix6d l_ref = llt.matrixL();
@@ -71,7 +75,7 @@ void ExpectLuMatchesEigen(const Matrix6d& a, const Vector6d& b, double cond) {
 TEST(LinearAlgebra6, CholeskyOfTheModelsInertiaMatchesEigen) {
   std::mt19937 rng(41);
   for (int n = 0; n < 500; ++n) {
-    const Vector6d q = RandomPoseInLimits(&rng);
+    const Vector6d q = RandomPose(&rng);
     const DynamicsTerms t = EvaluateDynamics(DefaultConfig().platform, q, RandomVelocity(&rng));
     const Eigen::JacobiSVD<Matrix6d> svd(t.M);
     const double cond = svd.singularValues()(0) / svd.singularValues()(5);
@@ -111,7 +115,7 @@ TEST(LinearAlgebra6, CholeskyReportsWhatIsNotPositiveDefinite) {
 TEST(LinearAlgebra6, PartialPivotSolveOfTheModelsHMatchesEigen) {
   std::mt19937 rng(47);
   for (int n = 0; n < 500; ++n) {
-    const Vector6d q = RandomPoseInLimits(&rng);
+    const Vector6d q = RandomPose(&rng);
     const DynamicsTerms t = EvaluateDynamics(DefaultConfig().platform, q, Vector6d::Zero());
     const Eigen::JacobiSVD<Matrix6d> svd(t.H);
     const double cond = svd.singularValues()(0) / svd.singularValues()(5);
@@ -145,4 +149,4 @@ TEST(LinearAlgebra6, PartialPivotSolveReportsSingularAndNonFiniteMatrices) {
 }
 
 }  // namespace
-}  // namespace stewart::safety::test
+}  // namespace stewart::test
