@@ -134,6 +134,8 @@ LcmReceiver::LcmReceiver(const std::string& url) : datagram_(kMaxDatagramBytes) 
   // As lcm::LCM does: every process on the bus binds the same port.
   const int one = 1;
   if (setsockopt(fd_, SOL_SOCKET, SO_REUSEADDR, &one, sizeof(one)) != 0) fail("SO_REUSEADDR");
+  // Arrival times from the kernel (recv_utime), as lcm::LCM takes them.
+  setsockopt(fd_, SOL_SOCKET, SO_TIMESTAMP, &one, sizeof(one));
   const int buf = address.recv_buf_size > 0 ? address.recv_buf_size : kDefaultRecvBufBytes;
   setsockopt(fd_, SOL_SOCKET, SO_RCVBUF, &buf, sizeof(buf));  // capped by rmem_max; best effort
   sockaddr_in bind_address{};
@@ -161,7 +163,19 @@ void LcmReceiver::AddSubscription(const std::string& channel, Dispatch dispatch)
   AttachFilter();
 }
 
+void LcmReceiver::SubscribeAll(RawHandler handler) {
+  all_ = std::move(handler);
+  const int unused = 0;  // the kernel wants an int-sized option even here
+  if (setsockopt(fd_, SOL_SOCKET, SO_DETACH_FILTER, &unused, sizeof(unused)) != 0 &&
+      errno != ENOENT) {
+    throw std::runtime_error(std::string("LCM receiver: cannot remove the channel filter: ") +
+                             std::strerror(errno));
+  }
+  filter_attached_ = false;
+}
+
 void LcmReceiver::AttachFilter() {
+  if (all_) return;  // a recorder takes everything
   std::vector<std::string> channels;
   for (const Subscription& s : subscriptions_) channels.push_back(s.channel);
   std::vector<sock_filter> program = BuildLcmChannelFilter(channels);
@@ -188,17 +202,33 @@ int LcmReceiver::HandleTimeoutUs(int64_t timeout_us) {
   int handled = 0;
   for (;;) {
     sockaddr_in from{};
-    socklen_t from_len = sizeof(from);
-    const ssize_t size = recvfrom(fd_, datagram_.data(), datagram_.size(), MSG_DONTWAIT,
-                                  reinterpret_cast<sockaddr*>(&from), &from_len);
+    iovec vec{datagram_.data(), datagram_.size()};
+    alignas(cmsghdr) char control[CMSG_SPACE(sizeof(timeval))];
+    msghdr msg{};
+    msg.msg_name = &from;
+    msg.msg_namelen = sizeof(from);
+    msg.msg_iov = &vec;
+    msg.msg_iovlen = 1;
+    msg.msg_control = control;
+    msg.msg_controllen = sizeof(control);
+    const ssize_t size = recvmsg(fd_, &msg, MSG_DONTWAIT);
     if (size < 0) {
       if (errno == EAGAIN || errno == EWOULDBLOCK) break;
       if (errno == EINTR) break;
       return handled > 0 ? handled : -1;
     }
     ++counters_.datagrams;
+    int64_t recv_utime = -1;
+    for (cmsghdr* c = CMSG_FIRSTHDR(&msg); c != nullptr; c = CMSG_NXTHDR(&msg, c)) {
+      if (c->cmsg_level == SOL_SOCKET && c->cmsg_type == SCM_TIMESTAMP) {
+        timeval tv{};
+        std::memcpy(&tv, CMSG_DATA(c), sizeof(tv));
+        recv_utime = int64_t{tv.tv_sec} * 1000000 + tv.tv_usec;
+      }
+    }
+    if (recv_utime < 0) recv_utime = WallUtime();
     handled += HandleDatagram(datagram_.data(), static_cast<int>(size), from.sin_addr.s_addr,
-                              from.sin_port, WallUtime());
+                              from.sin_port, recv_utime);
   }
   return handled;
 }
@@ -304,6 +334,13 @@ int LcmReceiver::HandleDatagram(const uint8_t* data, int size, uint32_t sender_i
 int LcmReceiver::Deliver(const char* channel, const uint8_t* data, uint32_t size,
                          int64_t recv_utime) {
   int handled = 0;
+  if (all_) {
+    lcm::ReceiveBuffer rbuf{const_cast<uint8_t*>(data), size, recv_utime};
+    channel_scratch_.assign(channel);  // reuses its capacity: no allocation per message
+    all_(rbuf, channel_scratch_);
+    ++handled;
+    ++counters_.messages;
+  }
   for (Subscription& s : subscriptions_) {
     if (s.channel != channel) continue;
     lcm::ReceiveBuffer rbuf{const_cast<uint8_t*>(data), size, recv_utime};

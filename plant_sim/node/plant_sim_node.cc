@@ -50,6 +50,7 @@ PlantSimNode::PlantSimNode(const StackConfig& config, const PlantSimOptions& opt
 
 int PlantSimNode::Run() {
   int status = 0;
+  const Clock::time_point started = Clock::now();
   try {
     health_.SetState(health_t::STATE_OK);
     status = options_.mode == SimMode::kLockstep ? RunLockstep() : RunRealTime();
@@ -67,8 +68,12 @@ int PlantSimNode::Run() {
       "samples)",
       latency_.Percentile(0.50), latency_.Percentile(0.99), latency_.max_us(), latency_.count());
   const PlantCounters c = plant_.counters();
-  spdlog::info("plant_sim: stopped at t = {:.3f} s after {} ticks; {} end-stop hits, {} rhs evals",
-               plant_.time_s(), tick_, c.endstop_hits, c.ode.rhs_evals);
+  const double wall_s = std::chrono::duration<double>(Clock::now() - started).count();
+  spdlog::info(
+      "plant_sim: stopped at t = {:.3f} s after {} ticks in {:.3f} s of wall time ({:.2f}x "
+      "real time); {} end-stop hits, {} rhs evals",
+      plant_.time_s(), tick_, wall_s, wall_s > 0.0 ? plant_.time_s() / wall_s : 0.0, c.endstop_hits,
+      c.ode.rhs_evals);
   return status;
 }
 

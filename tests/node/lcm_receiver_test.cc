@@ -14,6 +14,7 @@
 #include <cstring>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "stewart/force_command_t.hpp"
@@ -187,6 +188,47 @@ TEST(LcmReceiver, ReceivesShortAndFragmentedMessagesFromLcmAndOnlyItsChannels) {
   EXPECT_EQ(receiver.counters().messages, 51);
   EXPECT_LT(receiver.counters().datagrams, 50 + 20);
   EXPECT_EQ(receiver.counters().decode_failures, 0);
+}
+
+int64_t WallUtimeNow() {
+  return std::chrono::duration_cast<std::chrono::microseconds>(
+             std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+TEST(LcmReceiver, SubscribeAllTakesEveryChannelWithKernelArrivalTimes) {
+  const std::string url = PrivateLcmUrl(7804);
+  LcmReceiver receiver(url);
+  std::vector<std::string> channels;
+  std::vector<uint32_t> sizes;
+  std::vector<int64_t> recv_utimes;
+  receiver.SubscribeAll([&](const lcm::ReceiveBuffer& rbuf, const std::string& channel) {
+    channels.push_back(channel);
+    sizes.push_back(rbuf.data_size);
+    recv_utimes.push_back(rbuf.recv_utime);
+  });
+  EXPECT_FALSE(receiver.kernel_filter_attached());
+  auto lcm = MakeLcm(url);
+  const int64_t before = WallUtimeNow();
+  force_command_t command{};
+  lcm->publish("A", &command);
+  lcm->publish("SOMETHING_ELSE", &command);
+  health_t big{};
+  big.last_error = std::string(5000, 'y');  // fragmented
+  lcm->publish("BIG", &big);
+  const int64_t after = WallUtimeNow();
+  // Read late, as a batching recorder does: the times are still the arrivals.
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  PumpUntil(&receiver, [&] { return channels.size() == 3; });
+  const std::vector<std::string> expected = {"A", "SOMETHING_ELSE", "BIG"};
+  EXPECT_EQ(channels, expected);
+  ASSERT_EQ(sizes.size(), 3u);
+  EXPECT_EQ(sizes[0], static_cast<uint32_t>(command.getEncodedSize()));
+  EXPECT_EQ(sizes[2], static_cast<uint32_t>(big.getEncodedSize()));
+  for (int64_t t : recv_utimes) {
+    EXPECT_GE(t, before - 1000);
+    EXPECT_LE(t, after + 1000);  // not the read 50 ms later
+  }
 }
 
 // Raw datagrams to the bus, as a broken or hostile sender would send them.

@@ -1,35 +1,49 @@
 // stewart_logger: records every channel on an LCM URL into an LCM log file,
 // in the format lcm-logger writes (lcm-logplayer, lcm-spy, stewart_log_export
-// and stewart_replay read it). Why not lcm-logger: 1.3.1 subscribes with
-// LCM's default 30-message queue and silently drops bursts whenever it is
-// descheduled (measured on 2 cores: 0-861 messages per 4 s lockstep run, 6 %
-// of one 40 s run). This one queues up to --queue messages per
-// subscription, drains the queue before it exits, and reports what it wrote.
+// and stewart_replay read it).
+//
+// Why not lcm-logger: 1.3.1 subscribes with LCM's default 30-message queue
+// and silently drops bursts whenever it is descheduled (measured on 2 cores:
+// 0-861 messages per 4 s lockstep run, 6 % of one 40 s run), and like every
+// lcm::LCM receiver it is woken twice per message. This one reads the
+// socket itself (stewart::LcmReceiver) in batches: it sleeps --batch-ms
+// between reads and takes everything the kernel queued meanwhile (the socket
+// buffer, recv_buf_size on the URL, holds seconds of the stack's traffic),
+// so it wakes a few hundred times a second instead of 14 000 and leaves the
+// CPUs to the control loop. Each event keeps the kernel's arrival time of its
+// datagram (SO_TIMESTAMP), not the time of the batch. It drains the socket
+// before it exits and reports what it wrote.
 #include <spdlog/spdlog.h>
 
 #include <CLI/CLI.hpp>
-#include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <lcm/lcm-cpp.hpp>
+#include <memory>
+#include <regex>
 #include <string>
+#include <thread>
+#include <unordered_map>
+#include <utility>
 
-#include "stewart/node/lcm_handle.h"
+#include "stewart/node/lcm_receiver.h"
 #include "stewart/node/stop_signal.h"
 
 namespace {
 
 class Recorder {
  public:
-  explicit Recorder(lcm::LogFile* log) : log_(log) {}
+  Recorder(lcm::LogFile* log, std::regex channels) : log_(log), channels_(std::move(channels)) {}
 
-  void OnMessage(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+  void OnMessage(const lcm::ReceiveBuffer& rbuf, const std::string& channel) {
+    if (!Wanted(channel)) return;
     lcm::LogEvent event;
     event.eventnum = written_;
-    event.timestamp = rbuf->recv_utime;
+    event.timestamp = rbuf.recv_utime;
     event.channel = channel;
-    event.datalen = static_cast<int32_t>(rbuf->data_size);
-    event.data = rbuf->data;
+    event.datalen = static_cast<int32_t>(rbuf.data_size);
+    event.data = rbuf.data;
     if (log_->writeEvent(&event) == 0) {
       ++written_;
     } else {
@@ -41,7 +55,17 @@ class Recorder {
   int64_t failed() const { return failed_; }
 
  private:
+  // As LCM matches a subscription: the whole channel name against the regex.
+  bool Wanted(const std::string& channel) {
+    auto it = wanted_.find(channel);
+    if (it == wanted_.end())
+      it = wanted_.emplace(channel, std::regex_match(channel, channels_)).first;
+    return it->second;
+  }
+
   lcm::LogFile* log_;
+  std::regex channels_;
+  std::unordered_map<std::string, bool> wanted_;
   int64_t written_ = 0;
   int64_t failed_ = 0;
 };
@@ -51,12 +75,14 @@ class Recorder {
 int main(int argc, char** argv) {
   CLI::App app{"Record every LCM channel to a log file (lcm-logger format, no silent drops)"};
   std::string url, file, channels = ".*";
-  int queue = 1000000;
   double flush_s = 0.1;
+  int batch_ms = 2;
   bool force = false;
-  app.add_option("--lcm-url", url, "LCM URL (default: LCM's default)");
-  app.add_option("-c,--channel", channels, "channel regex")->capture_default_str();
-  app.add_option("--queue", queue, "messages queued before LCM drops any")->capture_default_str();
+  app.add_option("--lcm-url", url, "LCM URL (udpm://; default: LCM's default)");
+  app.add_option("-c,--channel", channels, "channel regex (the whole name must match)")
+      ->capture_default_str();
+  app.add_option("--batch-ms", batch_ms, "milliseconds slept between reads of the socket")
+      ->capture_default_str();
   app.add_option("--flush-interval", flush_s, "seconds between flushes")->capture_default_str();
   app.add_flag("-f,--force", force, "overwrite FILE");
   app.add_option("file", file, "log file")->required();
@@ -66,25 +92,52 @@ int main(int argc, char** argv) {
     spdlog::error("stewart_logger: {} exists (use -f to overwrite)", file);
     return 2;
   }
+  std::regex channel_regex;
+  try {
+    channel_regex = std::regex(channels);
+  } catch (const std::regex_error& e) {
+    spdlog::error("stewart_logger: bad channel regex '{}': {}", channels, e.what());
+    return 2;
+  }
+  std::unique_ptr<stewart::LcmReceiver> receiver;
+  try {
+    receiver = std::make_unique<stewart::LcmReceiver>(url);
+  } catch (const std::exception& e) {
+    spdlog::error("stewart_logger: {}", e.what());
+    return 1;
+  }
   lcm::LogFile log(file, "w");
   if (!log.good()) {
     spdlog::error("stewart_logger: cannot write {}", file);
     return 2;
   }
-  auto lcm = stewart::MakeLcm(url);  // exits with a clear message when LCM cannot start
-  Recorder recorder(&log);
-  lcm->subscribe(channels, &Recorder::OnMessage, &recorder)->setQueueCapacity(queue);
+  Recorder recorder(&log, std::move(channel_regex));
+  receiver->SubscribeAll([&](const lcm::ReceiveBuffer& rbuf, const std::string& channel) {
+    recorder.OnMessage(rbuf, channel);
+  });
   stewart::InstallStopSignalHandlers();
   spdlog::info("stewart_logger: {} -> {}", url.empty() ? "default URL" : url, file);
-  const int poll_ms = std::max(1, static_cast<int>(flush_s * 1000.0));
+  const auto flush_every = std::chrono::duration<double>(flush_s);
+  auto last_flush = std::chrono::steady_clock::now();
   while (!stewart::StopRequested()) {
-    if (lcm->handleTimeout(poll_ms) < 0) break;
-    std::fflush(log.getFilePtr());
+    if (receiver->HandleTimeout(100) < 0) {
+      spdlog::error("stewart_logger: receive failed");
+      break;
+    }
+    const auto now = std::chrono::steady_clock::now();
+    if (now - last_flush >= flush_every) {
+      std::fflush(log.getFilePtr());
+      last_flush = now;
+    }
+    if (batch_ms > 0) std::this_thread::sleep_for(std::chrono::milliseconds(batch_ms));
   }
-  while (lcm->handleTimeout(0) > 0) {  // drain what arrived before the stop
+  while (receiver->HandleTimeout(0) > 0) {  // drain what arrived before the stop
   }
   std::fflush(log.getFilePtr());
-  spdlog::info("stewart_logger: {} messages written, {} failed", recorder.written(),
-               recorder.failed());
+  const stewart::LcmReceiverCounters& c = receiver->counters();
+  spdlog::info(
+      "stewart_logger: {} messages written, {} failed ({} datagrams read, {} not LCM, "
+      "{} fragmented messages incomplete)",
+      recorder.written(), recorder.failed(), c.datagrams, c.bad_datagrams, c.incomplete_fragmented);
   return recorder.failed() == 0 ? 0 : 1;
 }

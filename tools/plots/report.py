@@ -244,8 +244,9 @@ def main():
         counters = plant_counters(run, config)
         if counters and "latency_p50_us" in counters:
             lines += [f"As the plant measures it (sample published to the first command derived "
-                      f"from it received, both on the plant's clock; the logger above runs at "
-                      f"normal priority and adds its own scheduling delay): p50 "
+                      f"from it received, both on the plant's clock, so it includes the plant's "
+                      f"own wake-up; the logger's times above are the kernel's arrival times of "
+                      f"the two datagrams): p50 "
                       f"{counters['latency_p50_us']} us, p99 {counters['latency_p99_us']} us, "
                       f"max {counters['latency_max_us']} us over "
                       f"{counters.get('answered_samples', '?')} answered samples.", ""]

@@ -16,6 +16,10 @@
 // lcm::LCM::publish (a synchronous sendmsg in the caller's thread). lcm-spy,
 // lcm-logger and lcm-logplayer see and feed the same bus.
 //
+// recv_utime is the kernel's arrival time of the datagram (SO_TIMESTAMP, the
+// wall clock in us, as LCM's), so it does not include how long the process
+// took to read it.
+//
 // What differs from lcm::LCM: there is no per-subscription queue that drops
 // the newest message at 30; the kernel socket buffer (recv_buf_size in the
 // URL, 2 MiB requested by default, capped by net.core.rmem_max) is the
@@ -77,6 +81,12 @@ class LcmReceiver {
         });
   }
 
+  /// Every message on every channel, undecoded (a recorder): the kernel
+  /// filter then passes everything. `channel` is the message's channel.
+  using RawHandler =
+      std::function<void(const lcm::ReceiveBuffer& rbuf, const std::string& channel)>;
+  void SubscribeAll(RawHandler handler);
+
   /// Waits up to timeout_ms (0: do not wait) for the socket, then handles
   /// every datagram already queued. Returns the number of messages handed
   /// to subscribers (0 on timeout), or -1 on a receive error.
@@ -108,6 +118,8 @@ class LcmReceiver {
 
   int fd_ = -1;
   std::vector<Subscription> subscriptions_;
+  RawHandler all_;  // set: every channel
+  std::string channel_scratch_;
   std::vector<uint8_t> datagram_;
   std::vector<std::unique_ptr<Reassembly>> reassemblies_;
   LcmReceiverCounters counters_;
