@@ -186,6 +186,12 @@ MONITOR_LOG="$OUT/monitor.log"
 now() { date +%s.%N; }
 elapsed() { awk -v a="$1" -v b="$(now)" 'BEGIN { printf "%.3f", b - a }'; }
 T0=$(now)
+# CPU time the hypervisor gave to others while we ran (the 8th field of the
+# cpu line, in USER_HZ ticks): on a virtual machine this, not our code, is
+# what usually explains a real-time hiccup.
+steal_ticks() { awk '/^cpu /{ print $9; exit }' /proc/stat 2>/dev/null || echo 0; }
+STEAL0=$(steal_ticks)
+LOAD0=$(cut -d' ' -f1 /proc/loadavg 2>/dev/null || echo "?")
 LAST_PROGRESS=""
 while :; do
   for i in "${!PIDS[@]}"; do
@@ -209,7 +215,11 @@ sleep 0.5  # let the logger flush the last messages
 stop_all
 trap - INT TERM
 printf "== done: %s s simulated in %.1f s wall ==\n" "$DURATION" "$WALL"
-echo "wall_time_s: $WALL" >> "$OUT/run.yaml"
+{
+  echo "wall_time_s: $WALL"
+  echo "load_average_at_start: $LOAD0"
+  echo "cpu_steal_s: $(awk -v a="$STEAL0" -v b="$(steal_ticks)" -v hz="$(getconf CLK_TCK)" 'BEGIN { printf "%.2f", (b - a) / hz }')"
+} >> "$OUT/run.yaml"
 
 if ((DO_REPORT)); then
   "$ROOT/tools/report.sh" "$OUT"

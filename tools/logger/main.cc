@@ -75,7 +75,7 @@ class Recorder {
 int main(int argc, char** argv) {
   CLI::App app{"Record every LCM channel to a log file (lcm-logger format, no silent drops)"};
   std::string url, file, channels = ".*";
-  double flush_s = 0.1;
+  double flush_s = 0.0;
   int batch_ms = 2;
   bool force = false;
   app.add_option("--lcm-url", url, "LCM URL (udpm://; default: LCM's default)");
@@ -83,7 +83,10 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--batch-ms", batch_ms, "milliseconds slept between reads of the socket")
       ->capture_default_str();
-  app.add_option("--flush-interval", flush_s, "seconds between flushes")->capture_default_str();
+  app.add_option("--flush-interval", flush_s,
+                 "seconds between flushes (0: after every batch, small writes a stock kernel does "
+                 "not hold a real-time task behind)")
+      ->capture_default_str();
   app.add_flag("-f,--force", force, "overwrite FILE");
   app.add_option("file", file, "log file")->required();
   CLI11_PARSE(app, argc, argv);
