@@ -28,11 +28,13 @@ usage: tools/launch.sh [options]
   --lcm-logger          record with the packaged lcm-logger instead of stewart_logger
   --rt-priority P       SCHED_FIFO priority of plant, estimator, controller and safety
                         (default: 50 in real time when permitted, else 0 = normal scheduling)
+  --loop-cpu N|auto|none  run those four on CPU N (auto: the last CPU when there are two
+                        or more; none: let the scheduler place them)
 USAGE
 }
 
 PLANT=sim MODE="" SCENARIO=paper CONFIG="$ROOT/config/platform.yaml" VARIANT="" DURATION=""
-LOG="" DO_LOG=1 DO_REPORT=1 SPY=0 URL="" OUT="" EMULATOR=0 BUILD_FIRST=1 LCM_LOGGER=0 RT_PRIORITY=
+LOG="" DO_LOG=1 DO_REPORT=1 SPY=0 URL="" OUT="" EMULATOR=0 BUILD_FIRST=1 LCM_LOGGER=0 RT_PRIORITY='' LOOP_CPU=auto
 ARGS="$*"
 while (($#)); do
   case "$1" in
@@ -53,6 +55,7 @@ while (($#)); do
     --no-build) BUILD_FIRST=0 ;;
     --lcm-logger) LCM_LOGGER=1 ;;
     --rt-priority) RT_PRIORITY=$2; shift ;;
+    --loop-cpu) LOOP_CPU=$2; shift ;;
     -h|--help) usage; exit 0 ;;
     *) echo "launch: unknown option '$1'" >&2; usage >&2; exit 2 ;;
   esac
@@ -76,6 +79,23 @@ if ((RT_PRIORITY > 0)); then
     { echo "launch: SCHED_FIFO $RT_PRIORITY not permitted (root or CAP_SYS_NICE / rtprio limit)" >&2; exit 2; }
   RT=(chrt -f "$RT_PRIORITY")
 fi
+# The loop is a chain (plant -> estimator -> controller -> safety -> plant):
+# on one CPU each hop is a plain context switch, across CPUs it is an
+# inter-processor wake-up, which on a virtual machine costs tens of us
+# (docs/performance.md, "Stack end to end"). The emulator (a stand-in for the
+# device's own processor) and the recorder stay off that CPU's schedule.
+if [[ $LOOP_CPU == auto ]]; then
+  LOOP_CPU=none
+  CPUS=$(nproc 2>/dev/null || echo 1)
+  if ((CPUS >= 2)) && command -v taskset >/dev/null; then LOOP_CPU=$((CPUS - 1)); fi
+fi
+PIN=()
+if [[ $LOOP_CPU != none ]]; then
+  [[ $LOOP_CPU =~ ^[0-9]+$ ]] || { echo "launch: --loop-cpu N|auto|none" >&2; exit 2; }
+  taskset -c "$LOOP_CPU" true 2>/dev/null || { echo "launch: cannot pin to CPU $LOOP_CPU" >&2; exit 2; }
+  PIN=(taskset -c "$LOOP_CPU")
+fi
+LOOP=("${PIN[@]}" "${RT[@]}")
 
 ((BUILD_FIRST)) && tools/setup.sh >/dev/null
 BUILD=${STEWART_BUILD_DIR:-$ROOT/build}
@@ -112,6 +132,7 @@ else cp "$ROOT/config/scenarios/$SCENARIO.yaml" "$OUT/scenario.yaml"; fi
   echo "duration_s: $DURATION"
   echo "variant: ${VARIANT:-from config}"
   echo "rt_priority: $RT_PRIORITY"
+  echo "loop_cpu: $LOOP_CPU"
   echo "lcm_url: $URL"
   echo "command: tools/launch.sh $ARGS"
 } > "$OUT/run.yaml"
@@ -120,6 +141,7 @@ echo "== Stewart stack: $PLANT, $MODE, scenario '$SCENARIO' ($DURATION s) =="
 echo "   run folder: $OUT"
 echo "   LCM URL:    $URL"
 ((RT_PRIORITY > 0)) && echo "   scheduling: SCHED_FIFO $RT_PRIORITY for the loop's processes"
+[[ $LOOP_CPU != none ]] && echo "   loop CPU:   $LOOP_CPU (plant, estimator, controller, safety)"
 echo "   process logs: $OUT/<process>.log"
 
 PIDS=() NAMES=()
@@ -164,19 +186,19 @@ if ((SPY)); then start lcm-spy "$ROOT/tools/lcm-spy" --lcm-url="$URL"; fi
 
 SAFETY_ARGS=("${COMMON[@]}")
 [[ -z $VARIANT ]] || SAFETY_ARGS+=(--variant "$VARIANT")
-start safety "${RT[@]}" "$SAFETY" "${SAFETY_ARGS[@]}"
-start controller "${RT[@]}" "$CONTROLLER" "${COMMON[@]}" --scenario "$SCENARIO"
-start estimator "${RT[@]}" "$ESTIMATOR" "${COMMON[@]}"
+start safety "${LOOP[@]}" "$SAFETY" "${SAFETY_ARGS[@]}"
+start controller "${LOOP[@]}" "$CONTROLLER" "${COMMON[@]}" --scenario "$SCENARIO"
+start estimator "${LOOP[@]}" "$ESTIMATOR" "${COMMON[@]}"
 "$MONITOR" "${COMMON[@]}" --wait-for safety,controller,estimator --timeout 15 ||
   { echo "launch: the stack did not come up" >&2; for n in safety controller estimator; do tail -n 5 "$OUT/$n.log" >&2; done; stop_all; exit 1; }
 
 if [[ $PLANT == sim ]]; then
-  start plant_sim "${RT[@]}" "$PLANT_SIM" "${COMMON[@]}" --mode "$MODE" --duration "$DURATION"
+  start plant_sim "${LOOP[@]}" "$PLANT_SIM" "${COMMON[@]}" --mode "$MODE" --duration "$DURATION"
   PLANT_NAME=plant_sim
 else
   # The emulator publishes its ground truth (evaluation only) on the run's URL.
   if ((EMULATOR)); then start hw_emulator "${RT[@]}" "$(bin hw_emulator)" "${COMMON[@]}"; fi
-  start hw_bridge "${RT[@]}" "$(bin hw_bridge)" "${COMMON[@]}"
+  start hw_bridge "${LOOP[@]}" "$(bin hw_bridge)" "${COMMON[@]}"
   PLANT_NAME=hw_bridge
 fi
 start monitor "$MONITOR" "${COMMON[@]}" --progress-of "$DURATION"

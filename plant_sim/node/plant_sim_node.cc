@@ -220,6 +220,8 @@ int PlantSimNode::RunRealTime() {
   const auto period = std::chrono::microseconds(period_us_);
   health_.SetCounter("overrun_ticks", 0);
   health_.SetCounter("missed_ticks", 0);
+  health_.SetCounter("missed_plant_late", 0);
+  health_.SetCounter("missed_stack_late", 0);
   const Clock::time_point start = Clock::now();
   for (tick_ = 0;; ++tick_) {
     const Clock::time_point deadline = start + tick_ * period;
@@ -242,10 +244,24 @@ int PlantSimNode::RunRealTime() {
     // sample got no command before this tick, so the stale one stays applied.
     const Clock::duration late = Clock::now() - deadline;
     tick_jitter_.Add(std::chrono::duration_cast<std::chrono::microseconds>(late).count());
-    if (late > period) health_.Count("overrun_ticks");
+    if (late > period) {
+      health_.Count("overrun_ticks");
+      const int64_t overruns = health_.counter("overrun_ticks");
+      if (overruns <= 20 || overruns % 100 == 0) {  // the exceptional path only
+        spdlog::warn("plant_sim: tick {} started {} us late (overrun {})", tick_,
+                     std::chrono::duration_cast<std::chrono::microseconds>(late).count(), overruns);
+      }
+    }
     if (tick_ > 0) {
       const int64_t previous_sample_utime = utime0_ + (tick_ - 1) * period_us_;
-      if (last_applied_sample_utime_ < previous_sample_utime) health_.Count("missed_ticks");
+      if (last_applied_sample_utime_ < previous_sample_utime) {
+        health_.Count("missed_ticks");
+        // Whose: the stack had less than half a period when the plant itself
+        // published the previous sample late (it catches up on the wall clock).
+        const Clock::duration window =
+            Clock::now() - sent_at_[static_cast<size_t>((tick_ - 1) % kSentRing)];
+        health_.Count(window < period / 2 ? "missed_plant_late" : "missed_stack_late");
+      }
     }
     PublishSample();
     if (options_.duration_s > 0.0 && plant_.time_s() >= options_.duration_s - 1e-9) break;

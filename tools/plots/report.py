@@ -251,13 +251,17 @@ def main():
                       f"max {counters['latency_max_us']} us over "
                       f"{counters.get('answered_samples', '?')} answered samples.", ""]
         if counters:
-            keys = [k for k in ("missed_ticks", "overrun_ticks", "tick_late_p99_us",
+            keys = [k for k in ("missed_ticks", "missed_stack_late", "missed_plant_late",
+                                "overrun_ticks", "tick_late_p99_us",
                                 "tick_late_max_us", "lockstep_resends",
                                 "command_timeouts", "endstop_hits", "ticks") if k in counters]
             lines += ["Plant counters at the end (its last health message): " +
                       ", ".join(f"{k} {counters[k]}" for k in keys) +
                       ". missed_ticks: ticks whose previous sample got no command in time "
-                      "(real time; includes the start-up before the stack answers).", ""]
+                      "(real time; includes the start-up before the stack answers), split into "
+                      "missed_stack_late (the stack had at least half a period and did not "
+                      "answer) and missed_plant_late (the plant itself published that sample "
+                      "late, leaving the stack less than half a period).", ""]
 
     lines += replay_section(run)
 
