@@ -4,7 +4,10 @@
 // Both receive sides are measured in one run, so compare their ratio:
 //   lcm       lcm::LCM::subscribe + handleTimeout (LCM's receive thread)
 //   receiver  stewart::LcmReceiver (the nodes' receive path)
-// Publishing is lcm::LCM::publish in both. Private URL, ttl=0.
+// Publishing is lcm::LCM::publish in both. Each is measured with the two
+// processes free to run on any CPU and pinned together to one CPU (what
+// tools/launch.sh does with the loop: --loop-cpu). Private URL, ttl=0.
+#include <sched.h>
 #include <signal.h>
 #include <spdlog/spdlog.h>
 #include <sys/wait.h>
@@ -50,9 +53,29 @@ struct Counter {
   for (;;) lcm->handleTimeout(1000);
 }
 
-// Round trips in microseconds, sorted.
-std::vector<double> Measure(const std::string& url, bool use_receiver, int round_trips) {
-  const pid_t child = fork();
+void PinTo(int cpu) {
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  CPU_SET(cpu, &set);
+  sched_setaffinity(0, sizeof(set), &set);
+}
+
+void Unpin() {
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  const long cpus = sysconf(_SC_NPROCESSORS_ONLN);
+  for (long c = 0; c < cpus; ++c) CPU_SET(static_cast<int>(c), &set);
+  sched_setaffinity(0, sizeof(set), &set);
+}
+
+// Round trips in microseconds, sorted. cpu >= 0: both processes on that CPU.
+std::vector<double> Measure(const std::string& url, bool use_receiver, int round_trips, int cpu) {
+  if (cpu >= 0) {
+    PinTo(cpu);
+  } else {
+    Unpin();
+  }
+  const pid_t child = fork();  // inherits the affinity
   if (child == 0) RunEcho(url, use_receiver);
   auto lcm = MakeLcm(url);
   Counter counter;
@@ -111,20 +134,29 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   try {
     const std::string url = stewart::PrivateLcmUrl(port);
-    std::printf("%-9s %10s %10s %10s %10s   (round trip = 2 hops, us)\n", "receive", "mean", "p50",
-                "p99", "n");
-    double p50[2] = {0.0, 0.0};
-    for (int r = 0; r < 2; ++r) {
-      const bool use_receiver = r == 1;
-      const std::vector<double> rtt = stewart::Measure(url, use_receiver, round_trips);
-      double mean = 0.0;
-      for (double v : rtt) mean += v;
-      mean /= std::max<size_t>(rtt.size(), 1);
-      p50[r] = stewart::At(rtt, 0.5);
-      std::printf("%-9s %10.1f %10.1f %10.1f %10zu\n", use_receiver ? "receiver" : "lcm", mean,
-                  p50[r], stewart::At(rtt, 0.99), rtt.size());
+    const int last_cpu = static_cast<int>(sysconf(_SC_NPROCESSORS_ONLN)) - 1;
+    std::printf("%-9s %-6s %10s %10s %10s %8s   (round trip = 2 hops, us)\n", "receive", "cpus",
+                "mean", "p50", "p99", "n");
+    double p50[2][2] = {{0.0, 0.0}, {0.0, 0.0}};
+    for (int pinned = 0; pinned < 2; ++pinned) {
+      for (int r = 0; r < 2; ++r) {
+        const bool use_receiver = r == 1;
+        const std::vector<double> rtt =
+            stewart::Measure(url, use_receiver, round_trips, pinned ? last_cpu : -1);
+        double mean = 0.0;
+        for (double v : rtt) mean += v;
+        mean /= static_cast<double>(std::max<size_t>(rtt.size(), 1));
+        p50[pinned][r] = stewart::At(rtt, 0.5);
+        const std::string cpus = pinned ? "cpu " + std::to_string(last_cpu) : "any";
+        std::printf("%-9s %-6s %10.1f %10.1f %10.1f %8zu\n", use_receiver ? "receiver" : "lcm",
+                    cpus.c_str(), mean, p50[pinned][r], stewart::At(rtt, 0.99), rtt.size());
+      }
     }
-    std::printf("p50 ratio lcm / receiver: %.2f\n", p50[1] > 0.0 ? p50[0] / p50[1] : 0.0);
+    auto ratio = [](double a, double b) { return b > 0.0 ? a / b : 0.0; };
+    std::printf(
+        "p50 ratios: lcm / receiver %.2f (any CPU), %.2f (one CPU); lcm on any CPU / "
+        "receiver on one CPU %.2f\n",
+        ratio(p50[0][0], p50[0][1]), ratio(p50[1][0], p50[1][1]), ratio(p50[0][0], p50[1][1]));
   } catch (const std::exception& e) {
     spdlog::error("stewart_lcm_hop_bench: {}", e.what());
     return 1;
