@@ -67,6 +67,14 @@ int PlantSimNode::Run() {
       "plant_sim: sample-to-command latency p50 {} us, p99 {} us, max {} us ({} answered "
       "samples)",
       latency_.Percentile(0.50), latency_.Percentile(0.99), latency_.max_us(), latency_.count());
+  if (options_.mode == SimMode::kRealTime) {
+    spdlog::info(
+        "plant_sim: missed ticks {} (stack late {}, plant late {}), overruns {}, tick "
+        "lateness p99 {} us, max {} us",
+        health_.counter("missed_ticks"), health_.counter("missed_stack_late"),
+        health_.counter("missed_plant_late"), health_.counter("overrun_ticks"),
+        tick_jitter_.Percentile(0.99), tick_jitter_.max_us());
+  }
   const PlantCounters c = plant_.counters();
   const double wall_s = std::chrono::duration<double>(Clock::now() - started).count();
   spdlog::info(
