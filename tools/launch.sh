@@ -16,7 +16,7 @@ usage: tools/launch.sh [options]
   --realtime            wall-clock paced at the sensor rate (default for hw)
   --scenario NAME|FILE  config/scenarios/NAME.yaml (default: paper)
   --config FILE         stack config (default: config/platform.yaml)
-  --variant V           safety filter: closed_form | paper | qp (default: from config)
+  --variant V           safety filter: closed_form | paper | qp | uncomposed (default: from config)
   --duration S          simulated seconds (default: the scenario's duration)
   --log FILE            record every channel with lcm-logger (default: <run>/log.lcm)
   --no-log              do not record (no report either)

@@ -33,6 +33,8 @@ std::string ToString(SafetyVariant variant) {
       return "paper";
     case SafetyVariant::kQpReference:
       return "qp";
+    case SafetyVariant::kUncomposed:
+      return "uncomposed";
   }
   return "?";
 }
@@ -41,7 +43,9 @@ SafetyVariant ParseSafetyVariant(const std::string& name) {
   if (name == "closed_form") return SafetyVariant::kClosedForm;
   if (name == "paper") return SafetyVariant::kPaperRule;
   if (name == "qp") return SafetyVariant::kQpReference;
-  throw std::invalid_argument("unknown safety variant '" + name + "' (closed_form | paper | qp)");
+  if (name == "uncomposed") return SafetyVariant::kUncomposed;
+  throw std::invalid_argument("unknown safety variant '" + name +
+                              "' (closed_form | paper | qp | uncomposed)");
 }
 
 std::string ToString(CorrectionMetric metric) {
@@ -56,7 +60,8 @@ CorrectionMetric ParseCorrectionMetric(const std::string& name) {
 
 SafetyConfig ParseSafetyConfig(const ConfigNode& safety) {
   SafetyConfig s;
-  s.variant = ParseSafetyVariant(safety.Choice("variant", {"closed_form", "paper", "qp"}));
+  s.variant =
+      ParseSafetyVariant(safety.Choice("variant", {"closed_form", "paper", "qp", "uncomposed"}));
   s.k_position = safety.PositiveDouble("k_position");
   s.k_velocity = safety.PositiveDouble("k_velocity");
   for (const ConfigNode& node : safety.List("position_limits")) {

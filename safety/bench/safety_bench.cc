@@ -143,6 +143,22 @@ void BM_ForceLimitedFullStep(benchmark::State& state) {
 }
 BENCHMARK(BM_ForceLimitedFullStep);
 
+// The un-composed QP (every barrier its own row, dual active set), full
+// step, unlimited and force-limited: what dropping the LSE costs per step.
+void BM_UncomposedFullStep(benchmark::State& state) {
+  SafetyConfig s = Config().safety;
+  s.variant = SafetyVariant::kUncomposed;
+  s.force_limits_enabled = state.range(0) != 0;
+  SafetyFilter filter(Config().platform, s, Config().actuators);
+  SafetyDiagnostics d;
+  size_t i = 0;
+  for (auto _ : state) {
+    const Sample& x = Samples()[i++ & 255];
+    benchmark::DoNotOptimize(filter.Step(x.q, x.qd, x.f_des, &d));
+  }
+}
+BENCHMARK(BM_UncomposedFullStep)->ArgName("force_limits")->Arg(0)->Arg(1);
+
 void BM_ModelTermsOnly(benchmark::State& state) {
   DynamicsTerms t;
   size_t i = 0;

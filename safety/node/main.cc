@@ -1,5 +1,6 @@
 // safety: the CBF safety filter as a process.
-//   safety [--variant closed_form|paper|qp] [--force-limits] [-c config.yaml] [--lcm-url URL]
+//   safety [--variant closed_form|paper|qp|uncomposed] [--force-limits] [-c config.yaml] [--lcm-url
+//   URL]
 #include <spdlog/spdlog.h>
 
 #include <CLI/CLI.hpp>
@@ -17,7 +18,8 @@ int main(int argc, char** argv) {
   stewart::AddNodeOptions(&app, &options);
   std::string variant;
   bool force_limits = false;
-  app.add_option("--variant", variant, "closed_form | paper | qp (default: safety.variant)");
+  app.add_option("--variant", variant,
+                 "closed_form | paper | qp | uncomposed (default: safety.variant)");
   app.add_flag("--force-limits", force_limits, "also enforce |F_i| <= actuators.force_limit_n");
   CLI11_PARSE(app, argc, argv);
   stewart::StackConfig config = stewart::LoadNodeConfigOrExit(options);

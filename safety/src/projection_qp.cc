@@ -1,24 +1,39 @@
 #include "stewart/safety/projection_qp.h"
 
 #include <Eigen/Cholesky>
+#include <Eigen/QR>
+#include <algorithm>
 #include <cmath>
 #include <limits>
+
+#include "stewart/safety/uncomposed_qp.h"
 
 namespace stewart::safety {
 namespace {
 
 constexpr double kFeasTol = 1e-12;       // relative to |b| + |a| |x|
 constexpr double kDependentTol = 1e-20;  // ||z||^2 vs ||a_p||^2: a_p in span
-constexpr int kMaxIterations = 60;
+// Each iteration adds one constraint; 60 was ample for the 14-row QP, and a
+// bigger QP may need more active-set changes (4 per row: its value for 14
+// rows would be 56, so the composed filter keeps exactly its 60).
+template <int MaxRows>
+constexpr int kMaxIterations = std::max(60, 4 * MaxRows);
 
 using ActiveMatrix = Eigen::Matrix<double, Eigen::Dynamic, 6, 0, 6, 6>;
 using ActiveVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 6, 1>;
 using ActiveGram = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 6, 6>;
 
 // Re-solves the final active set directly so the active constraints hold to
-// rounding, whatever the path the iteration took.
-void Polish(const ProjectionQp& qp, const std::array<int, 6>& active, int num_active,
-            ProjectionResult* res) {
+// rounding, whatever the path the iteration took: x = x0 + N^T mu with
+// N N^T mu = b_N - N x0, through the QR factors of N^T = Q R (so that
+// x - x0 = Q R^-T r and mu = R^-1 R^-T r). Not through the Gram N N^T: two
+// nearly parallel active normals (a position row and a velocity row near a
+// limit, multipliers ~1e7) would square its condition number and leave the
+// constraints violated by ~1e-10 relative. One step of refinement on the
+// residual takes the rest.
+template <int MaxRows>
+void Polish(const ProjectionQpN<MaxRows>& qp, const std::array<int, 6>& active, int num_active,
+            ProjectionResultN<MaxRows>* res) {
   if (num_active == 0) return;
   ActiveMatrix n(num_active, 6);
   ActiveVector rhs(num_active);
@@ -27,25 +42,40 @@ void Polish(const ProjectionQp& qp, const std::array<int, 6>& active, int num_ac
     n.row(j) = qp.a.row(i);
     rhs(j) = qp.b(i) - qp.a.row(i).dot(qp.x0);
   }
-  const ActiveGram gram = n * n.transpose();
-  const ActiveVector mu = gram.ldlt().solve(rhs);
-  if (!mu.allFinite() || (mu.array() < 0.0).any()) return;
-  Vector6d x = qp.x0 + n.transpose() * mu;
-  res->x = x;
+  using Transposed = Eigen::Matrix<double, 6, Eigen::Dynamic, 0, 6, 6>;
+  const Eigen::HouseholderQR<Transposed> qr(Transposed(n.transpose()));
+  const auto r =
+      qr.matrixQR().topLeftCorner(num_active, num_active).template triangularView<Eigen::Upper>();
+  const double r_max = qr.matrixQR().diagonal().head(num_active).cwiseAbs().maxCoeff();
+  if (!(qr.matrixQR().diagonal().head(num_active).cwiseAbs().minCoeff() > 1e-14 * r_max)) return;
+  Vector6d dx = Vector6d::Zero();
+  ActiveVector mu = ActiveVector::Zero(num_active);
+  ActiveVector residual = rhs;
+  for (int pass = 0; pass < 2; ++pass) {
+    const ActiveVector z = r.transpose().solve(residual);
+    Vector6d z_full = Vector6d::Zero();
+    z_full.head(num_active) = z;
+    dx += qr.householderQ() * z_full;
+    mu += r.solve(z);
+    residual = rhs - n * dx;
+  }
+  if (!dx.allFinite() || !mu.allFinite() || (mu.array() < 0.0).any()) return;
+  res->x = qp.x0 + dx;
   for (int j = 0; j < num_active; ++j) res->mu(active[static_cast<size_t>(j)]) = mu(j);
 }
 
 }  // namespace
 
-ProjectionResult SolveProjectionQp(const ProjectionQp& qp) {
-  ProjectionResult res;
+template <int MaxRows>
+ProjectionResultN<MaxRows> SolveProjectionQp(const ProjectionQpN<MaxRows>& qp) {
+  ProjectionResultN<MaxRows> res;
   res.mu.setZero();
   res.x = qp.x0;
   std::array<int, 6> active{};
   int num_active = 0;
-  std::array<bool, kMaxQpRows> is_active{};
+  std::array<bool, MaxRows> is_active{};
 
-  for (int iter = 0; iter < kMaxIterations; ++iter) {
+  for (int iter = 0; iter < kMaxIterations<MaxRows>; ++iter) {
     res.iterations = iter + 1;
     // Most violated inactive constraint, scaled by its normal's length.
     int p = -1;
@@ -78,7 +108,10 @@ ProjectionResult SolveProjectionQp(const ProjectionQp& qp) {
         z -= n.transpose() * r;
       }
       const double inf = std::numeric_limits<double>::infinity();
-      const bool dependent = z.squaredNorm() <= kDependentTol * a_p.squaredNorm();
+      // Six independent normals span R^6: a seventh is dependent, whatever
+      // rounding left in z (this also keeps `active` within its 6 entries).
+      const bool dependent =
+          num_active == 6 || z.squaredNorm() <= kDependentTol * a_p.squaredNorm();
       const double t1 = dependent ? inf : (qp.b(p) - a_p.dot(res.x)) / z.dot(a_p);
       double t2 = inf;
       int drop = -1;
@@ -125,5 +158,10 @@ ProjectionResult SolveProjectionQp(const ProjectionQp& qp) {
   res.status = ProjectionStatus::kIterationLimit;
   return res;
 }
+
+// The two capacities in use: the composed filter's QP and the un-composed one.
+template ProjectionResultN<kMaxQpRows> SolveProjectionQp(const ProjectionQpN<kMaxQpRows>&);
+template ProjectionResultN<kMaxUncomposedQpRows> SolveProjectionQp(
+    const ProjectionQpN<kMaxUncomposedQpRows>&);
 
 }  // namespace stewart::safety

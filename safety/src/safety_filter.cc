@@ -113,6 +113,8 @@ Vector6d SafetyFilter::StepWithTerms(const DynamicsTerms& terms, const Vector6d&
   d->flags = 0;
   d->infeasible = false;
   d->mu_p = d->mu_v = 0.0;
+  d->mu_position.fill(0.0);
+  d->mu_velocity.fill(0.0);
   d->mu_force.setZero();
   d->f_des = f_des;
   d->compute_ns = 0;
@@ -127,12 +129,15 @@ Vector6d SafetyFilter::StepWithTerms(const DynamicsTerms& terms, const Vector6d&
     ok = BarriersFinite(d->barriers) && (metric_ == CorrectionMetric::kForce || x.inertia_valid);
   }
   if (ok) {
-    if (variant_ == SafetyVariant::kQpReference || force_limits_) {
+    if (variant_ == SafetyVariant::kQpReference || variant_ == SafetyVariant::kUncomposed ||
+        force_limits_) {
       // These pose the QP in y = T^-1 F, so they need T itself.
       Matrix6d map;
       ok = ComputeMetricMap(terms, x, &map);
       if (ok && variant_ == SafetyVariant::kQpReference) {
         SolveReference(terms, qd, x, map, d->barriers, f_des, d);
+      } else if (ok && variant_ == SafetyVariant::kUncomposed) {
+        SolveUncomposed(terms, qd, x, map, d->barriers, f_des, d);
       } else if (ok) {
         SolveForceLimited(terms, qd, map, d->barriers, f_des, d);
       }
@@ -145,6 +150,8 @@ Vector6d SafetyFilter::StepWithTerms(const DynamicsTerms& terms, const Vector6d&
     // Last resort: nothing trustworthy to filter. Flagged, never F_des.
     d->barriers = BarrierEvaluation{};
     d->mu_p = d->mu_v = 0.0;
+    d->mu_position.fill(0.0);
+    d->mu_velocity.fill(0.0);
     d->mu_force.setZero();
     d->filter_case = FilterCase::kFallback;
     d->flags |= kFlagFallback | (input_valid ? kFlagInfeasible : kFlagInvalidInput);

@@ -1,7 +1,7 @@
 // safety_tool: reads {"q":[6],"qd":[6],"f_des":[6]} JSON lines on stdin and
 // prints F* and the filter's diagnostics as one JSON line each: how a user
 // finds out why the filter acted.
-//   safety_tool [--config FILE] [--variant closed_form|paper|qp] [--force-limits]
+//   safety_tool [--config FILE] [--variant closed_form|paper|qp|uncomposed] [--force-limits]
 #include <CLI/CLI.hpp>
 #include <iostream>
 #include <nlohmann/json.hpp>
@@ -37,7 +37,8 @@ int main(int argc, char** argv) {
   std::string variant;
   bool force_limits = false;
   app.add_option("--config", config_path, "platform YAML");
-  app.add_option("--variant", variant, "closed_form | paper | qp (default: from config)");
+  app.add_option("--variant", variant,
+                 "closed_form | paper | qp | uncomposed (default: from config)");
   app.add_flag("--force-limits", force_limits, "also enforce |F_i| <= actuators.force_limit_n");
   CLI11_PARSE(app, argc, argv);
   try {
@@ -80,6 +81,15 @@ int main(int argc, char** argv) {
         out["mu_p"] = d.mu_p;
         out["mu_v"] = d.mu_v;
         out["mu_force"] = ToJson(d.mu_force);
+        if (d.variant == stewart::SafetyVariant::kUncomposed) {
+          // Each barrier's own multiplier; mu_p, mu_v above are their sums.
+          for (size_t i = 0; i < static_cast<size_t>(c.num_position); ++i) {
+            out["position"][c.position[i].name]["mu"] = d.mu_position[i];
+          }
+          for (size_t i = 0; i < static_cast<size_t>(c.num_velocity); ++i) {
+            out["velocity"][c.velocity[i].name]["mu"] = d.mu_velocity[i];
+          }
+        }
         out["f_des"] = ToJson(d.f_des.allFinite() ? d.f_des : Vector6d::Zero());
         out["correction_norm"] = d.correction_norm;
         out["compute_ns"] = d.compute_ns;

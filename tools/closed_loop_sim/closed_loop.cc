@@ -39,6 +39,16 @@ void TrackLimitExcess(const SafetyConfig& s, const Vector6d& q, const Vector6d& 
   }
 }
 
+// Whether the setpoint of `axis` lies within that axis' configured limits.
+bool SetpointInside(const SafetyConfig& s, int axis, double q_des) {
+  for (const PositionLimitConfig& l : s.position_limits) {
+    if (l.axis != axis) continue;
+    if (l.upper && q_des > *l.upper) return false;
+    if (l.lower && q_des < *l.lower) return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 ClosedLoopSummary RunClosedLoop(const StackConfig& config, const Scenario& scenario,
@@ -55,7 +65,9 @@ ClosedLoopSummary RunClosedLoop(const StackConfig& config, const Scenario& scena
   const std::int64_t period_us = std::llround(1e6 / sensors.rate_hz);
   const long ticks = std::lround(options.duration_s * 1e6 / static_cast<double>(period_us));
   ClosedLoopSummary out;
+  out.period_s = static_cast<double>(period_us) * 1e-6;
   double sq_q = 0.0, sq_qd = 0.0;
+  Vector6d sq_tracking = Vector6d::Zero();
   long estimated_ticks = 0;
   if (csv) {
     *csv << "t";
@@ -100,6 +112,15 @@ ClosedLoopSummary RunClosedLoop(const StackConfig& config, const Scenario& scena
     safety::SafetyDiagnostics d;
     if (controller.Step(utime, q, qd, &c) == StepStatus::kOk && state_trusted) {
       f_safe = options.no_filter ? c.force_n : filter.Step(q, qd, c.force_n, &d);
+      ++out.filtered_ticks;
+      out.sum_correction_n += (f_safe - c.force_n).norm();
+      if ((f_safe - c.force_n).norm() > 0.0) ++out.active_ticks;
+      for (int a = 0; a < 6; ++a) {
+        if (!SetpointInside(config.safety, a, c.setpoint.q_des(a))) continue;
+        ++out.inside_ticks[static_cast<size_t>(a)];
+        const double e = q_true(a) - c.setpoint.q_des(a);
+        sq_tracking(a) += e * e;
+      }
     } else {
       f_safe = filter.SafeStopCommand(q, qd, &d);
     }
@@ -133,13 +154,18 @@ ClosedLoopSummary RunClosedLoop(const StackConfig& config, const Scenario& scena
     out.rms_q_error = std::sqrt(sq_q / static_cast<double>(estimated_ticks));
     out.rms_qd_error = std::sqrt(sq_qd / static_cast<double>(estimated_ticks));
   }
+  for (int a = 0; a < 6; ++a) {
+    const long n = out.inside_ticks[static_cast<size_t>(a)];
+    if (n > 0)
+      out.rms_tracking_error_inside(a) = std::sqrt(sq_tracking(a) / static_cast<double>(n));
+  }
   out.completed = true;
   return out;
 }
 
 std::string FormatSummary(const StackConfig& config, const ClosedLoopSummary& s) {
   std::ostringstream o;
-  char line[256];
+  char line[512];
   o << "axis      q_min      q_max   limit |    qd_min     qd_max   limit\n";
   for (int a = 0; a < 6; ++a) {
     std::string pos_limit = "-", vel_limit = "-";
@@ -164,6 +190,15 @@ std::string FormatSummary(const StackConfig& config, const ClosedLoopSummary& s)
                 "final q [%.4f %.4f %.4f %.4f %.4f %.4f]\n",
                 s.rms_q_error, s.rms_qd_error, s.estimator_reinits, s.q_final(0), s.q_final(1),
                 s.q_final(2), s.q_final(3), s.q_final(4), s.q_final(5));
+  o << line;
+  std::snprintf(line, sizeof line,
+                "filter (%s): active %.2f s of %ld filtered ticks, mean |F*-F_des| %.4g N; "
+                "rms tracking error where the setpoint is inside the limits: x %.4g y %.4g "
+                "z %.4g m (%ld/%ld/%ld ticks)\n",
+                ToString(config.safety.variant).c_str(), s.active_time_s(), s.filtered_ticks,
+                s.mean_correction_n(), s.rms_tracking_error_inside(0),
+                s.rms_tracking_error_inside(1), s.rms_tracking_error_inside(2), s.inside_ticks[0],
+                s.inside_ticks[1], s.inside_ticks[2]);
   o << line;
   return o.str();
 }

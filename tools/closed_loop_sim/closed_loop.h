@@ -34,6 +34,20 @@ struct ClosedLoopSummary {
   double max_force_n = 0.0;
   long estimator_reinits = 0;
   Vector6d q_final = Vector6d::Zero();
+  // What the filter costs (docs/safety.md, "The un-composed QP"):
+  long filtered_ticks = 0;        ///< ticks the filter ran on a nominal command
+  long active_ticks = 0;          ///< of those, ticks with F* != F_des
+  double sum_correction_n = 0.0;  ///< sum of ||F* - F_des|| over filtered ticks (N)
+  double period_s = 0.0;          ///< control period (s)
+  /// Per axis: ticks where that axis' setpoint is inside its position limits
+  /// (always, for an axis without limits), and the RMS of q_true - q_des over
+  /// them (m, rad): the tracking the filter should not cost.
+  std::array<long, 6> inside_ticks{};
+  Vector6d rms_tracking_error_inside = Vector6d::Zero();
+  double mean_correction_n() const {
+    return filtered_ticks > 0 ? sum_correction_n / static_cast<double>(filtered_ticks) : 0.0;
+  }
+  double active_time_s() const { return static_cast<double>(active_ticks) * period_s; }
 };
 
 /// Runs `scenario` for options.duration_s at the sensor rate. `csv`, when not

@@ -32,7 +32,7 @@ int main(int argc, char** argv) {
   app.add_option("--seed", options.seed, "sensor noise seed");
   app.add_option("--k-velocity", k_velocity, "override safety.k_velocity");
   app.add_option("--k-position", k_position, "override safety.k_position");
-  app.add_option("--variant", variant, "closed_form | paper");
+  app.add_option("--variant", variant, "closed_form | paper | uncomposed");
   app.add_flag("--no-filter", options.no_filter, "pass F_des through (to see what it prevents)");
   app.add_option("--csv", csv_path, "write t, q, qd, q_est, qd_est, F_des, F*, case per tick");
   CLI11_PARSE(app, argc, argv);

@@ -3,9 +3,13 @@
 
 #include <libalglib/optimization.h>
 
-namespace stewart::safety {
+#include <algorithm>
 
-ProjectionStatus AlglibReferenceQp::Solve(const ProjectionQp& qp, Vector6d* x) {
+namespace stewart::safety {
+namespace {
+
+template <int MaxRows>
+ProjectionStatus SolveWithAlglib(const ProjectionQpN<MaxRows>& qp, Vector6d* x) {
   try {
     alglib::real_2d_array quadratic;
     quadratic.setlength(6, 6);
@@ -46,6 +50,41 @@ ProjectionStatus AlglibReferenceQp::Solve(const ProjectionQp& qp, Vector6d* x) {
   } catch (const alglib::ap_error&) {
     return ProjectionStatus::kIterationLimit;
   }
+}
+
+}  // namespace
+
+ProjectionStatus AlglibReferenceQp::Solve(const ProjectionQp& qp, Vector6d* x) {
+  return SolveWithAlglib(qp, x);
+}
+
+ProjectionStatus AlglibReferenceQp::Solve(const UncomposedQp& qp, Vector6d* x) {
+  // Presolve: rows with the same unit normal (every position barrier's row
+  // has the normal of -H^T qd) are merged into the most restrictive one, an
+  // exactly equivalent QP. BLEIC's feasibility phase declares ~1 % of the
+  // un-merged QPs "inconsistent" (terminationtype -3) even when a single row
+  // is active at the optimum.
+  UncomposedQp merged;
+  merged.x0 = qp.x0;
+  merged.m = 0;
+  for (int r = 0; r < qp.m; ++r) {
+    const double norm = qp.a.row(r).norm();
+    if (!(norm > 0.0)) return ProjectionStatus::kIterationLimit;
+    const Eigen::Matrix<double, 1, 6> unit = qp.a.row(r) / norm;
+    const double b = qp.b(r) / norm;
+    int same = -1;
+    for (int k = 0; k < merged.m && same < 0; ++k) {
+      if ((merged.a.row(k) - unit).cwiseAbs().maxCoeff() <= 1e-14) same = k;
+    }
+    if (same >= 0) {
+      merged.b(same) = std::max(merged.b(same), b);
+    } else {
+      merged.a.row(merged.m) = unit;
+      merged.b(merged.m) = b;
+      ++merged.m;
+    }
+  }
+  return SolveWithAlglib(merged, x);
 }
 
 }  // namespace stewart::safety

@@ -29,7 +29,9 @@ struct LegStrokeLimitConfig {
   double alpha = 1.0;
 };
 
-enum class SafetyVariant { kClosedForm, kPaperRule, kQpReference };
+/// kUncomposed: every barrier its own condition, no LSE (docs/safety.md,
+/// "The un-composed QP"), to measure what the composition costs.
+enum class SafetyVariant { kClosedForm, kPaperRule, kQpReference, kUncomposed };
 enum class SafetyFallback { kHold, kZero };
 
 /// How the filter measures the size of its correction F* - F_des

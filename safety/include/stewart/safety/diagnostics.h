@@ -25,7 +25,16 @@ struct SafetyDiagnostics {
   bool infeasible = false;
   std::int32_t flags = 0;  ///< FilterFlag bits
   BarrierEvaluation barriers;
+  /// KKT multipliers of the two composed conditions. Variant uncomposed: the
+  /// sums of its position / velocity rows' multipliers (mu_position,
+  /// mu_velocity below), in the same units (docs/safety.md).
   double mu_p = 0.0, mu_v = 0.0;
+  /// Variant uncomposed only (zero otherwise): the multiplier of each
+  /// barrier's own condition Psi_i(F) = alpha_i (dh_i(F) + h_i) - delta >= 0,
+  /// whose gradient is n_i = alpha_i g_i, so that
+  /// F* = F_des + W^-1 (sum_i mu_i n_i - mu_force) (uncomposed_qp.h).
+  std::array<double, kMaxPositionBarriers> mu_position{};
+  std::array<double, kMaxVelocityBarriers> mu_velocity{};
   /// Force-limit multipliers, signed: + upper bound active, - lower.
   /// F* = F_des + mu_p g_p + mu_v g_v - mu_force.
   Vector6d mu_force = Vector6d::Zero();

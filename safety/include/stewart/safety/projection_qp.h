@@ -1,7 +1,8 @@
 #pragma once
-// Exact solver of the small projection QP behind the force-limited filter:
+// Exact solver of the small projection QPs behind the force-limited filter
+// and the un-composed variant:
 //
-//   min 1/2 ||x - x0||^2   s.t.  a_i^T x >= b_i,  i < m  (x in R^6, m <= 14)
+//   min 1/2 ||x - x0||^2   s.t.  a_i^T x >= b_i,  i < m  (x in R^6, m <= MaxRows)
 //
 // Goldfarb-Idnani dual active-set method with identity Hessian: start at the
 // unconstrained minimum x0, add the most violated constraint, and move along
@@ -9,31 +10,48 @@
 // multiplier non-negative (dropping a constraint whose multiplier reaches 0).
 // It terminates after finitely many active-set changes at the exact KKT
 // point, or proves infeasibility (a_p depends on active normals with
-// non-positive weights). Fixed-size storage: no heap allocation.
+// non-positive weights). At most 6 rows are active at once (their normals
+// stay linearly independent in R^6), whatever the row capacity.
+//
+// The row capacity is a compile-time parameter so that each QP keeps
+// fixed-size storage (no heap allocation) sized for what it poses: the
+// composed filter's 2 + 12 rows (ProjectionQp, the default), the
+// un-composed variant's up to 24 + 12 + 12 (uncomposed_qp.h). Instantiated
+// for those two capacities in projection_qp.cc.
 #include <array>
 
 #include "stewart/model/types.h"
 
 namespace stewart::safety {
 
+/// Rows of the composed filter's QP: 2 CBF conditions + 2 force limits per leg.
 constexpr int kMaxQpRows = 2 + 2 * kNumLegs;
 
-struct ProjectionQp {
+template <int MaxRows>
+struct ProjectionQpN {
+  static constexpr int kMaxRows = MaxRows;
   int m = 0;
-  Eigen::Matrix<double, kMaxQpRows, 6> a;  ///< rows a_i^T
-  Eigen::Matrix<double, kMaxQpRows, 1> b;
+  Eigen::Matrix<double, MaxRows, 6> a;  ///< rows a_i^T
+  Eigen::Matrix<double, MaxRows, 1> b;
   Vector6d x0 = Vector6d::Zero();
 };
 
 enum class ProjectionStatus { kOptimal, kInfeasible, kIterationLimit };
 
-struct ProjectionResult {
+template <int MaxRows>
+struct ProjectionResultN {
   ProjectionStatus status = ProjectionStatus::kOptimal;
   Vector6d x = Vector6d::Zero();
-  Eigen::Matrix<double, kMaxQpRows, 1> mu;  ///< x = x0 + sum mu_i a_i, mu >= 0
+  Eigen::Matrix<double, MaxRows, 1> mu;  ///< x = x0 + sum mu_i a_i, mu >= 0
   int iterations = 0;
 };
 
-ProjectionResult SolveProjectionQp(const ProjectionQp& qp);
+using ProjectionQp = ProjectionQpN<kMaxQpRows>;
+using ProjectionResult = ProjectionResultN<kMaxQpRows>;
+
+template <int MaxRows>
+ProjectionResultN<MaxRows> SolveProjectionQp(const ProjectionQpN<MaxRows>& qp);
+
+extern template ProjectionResultN<kMaxQpRows> SolveProjectionQp(const ProjectionQpN<kMaxQpRows>&);
 
 }  // namespace stewart::safety

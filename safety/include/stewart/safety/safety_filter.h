@@ -18,6 +18,7 @@
 #include "stewart/safety/constraint_set.h"
 #include "stewart/safety/diagnostics.h"
 #include "stewart/safety/reference_qp.h"
+#include "stewart/safety/uncomposed_qp.h"
 
 namespace stewart::safety {
 
@@ -72,7 +73,19 @@ class SafetyFilter {
   bool BuildQp(const Matrix6d& metric_map, const BarrierEvaluation& barriers, const Vector6d& f_des,
                ProjectionQp* qp, QpRows* rows = nullptr) const;
 
-  /// F = T y for a solution y of the QP from BuildQp.
+  /// The un-composed QP at this step (uncomposed_qp.h, variant uncomposed):
+  /// one row per barrier, alpha_i (dh_i(F) + h_i) >= delta_group, evaluated
+  /// like the composed conditions at the net force F + friction, in the same
+  /// coordinates y = T^-1 F as BuildQp, rows T^T alpha_i g_i scaled to unit
+  /// normals, then the box rows when force limits are on. `barriers` must come
+  /// from the filter at the same (q, qd, F_des) (SafetyDiagnostics::barriers).
+  /// Rows with a zero normal are left out; returns false when one of them is
+  /// violated (no force can satisfy it).
+  bool BuildUncomposedQp(const DynamicsTerms& terms, const Vector6d& qd, const Matrix6d& metric_map,
+                         const BarrierEvaluation& barriers, const Vector6d& f_des, UncomposedQp* qp,
+                         UncomposedQpRows* rows = nullptr) const;
+
+  /// F = T y for a solution y of the QP from BuildQp or BuildUncomposedQp.
   static Vector6d ForceFromQpSolution(const Matrix6d& metric_map, const Vector6d& y) {
     return metric_map * y;
   }
@@ -99,6 +112,13 @@ class SafetyFilter {
   void SolveReference(const DynamicsTerms& terms, const Vector6d& qd, const BarrierIntermediates& x,
                       const Matrix6d& map, const BarrierEvaluation& b, const Vector6d& f_des,
                       SafetyDiagnostics* d) const;
+  bool BuildUncomposedQp(const DynamicsTerms& terms, const Vector6d& qd, const Cholesky6& inertia,
+                         const Matrix6d& map, const BarrierEvaluation& b, const Vector6d& f_des,
+                         UncomposedQp* qp, UncomposedQpRows* rows) const;
+  void SolveUncomposed(const DynamicsTerms& terms, const Vector6d& qd,
+                       const BarrierIntermediates& x, const Matrix6d& map,
+                       const BarrierEvaluation& b, const Vector6d& f_des,
+                       SafetyDiagnostics* d) const;
 
   PlatformParams platform_;
   ConstraintSet constraints_;

@@ -19,6 +19,8 @@ inline std::int8_t ToLcmVariant(SafetyVariant v) {
       return safety_diagnostics_t::VARIANT_PAPER_RULE;
     case SafetyVariant::kQpReference:
       return safety_diagnostics_t::VARIANT_QP_REFERENCE;
+    case SafetyVariant::kUncomposed:
+      return safety_diagnostics_t::VARIANT_UNCOMPOSED;
   }
   return safety_diagnostics_t::VARIANT_CLOSED_FORM;
 }
