@@ -24,7 +24,8 @@ Msg RoundTrip(const Msg& in) {
             static_cast<int>(buffer.size()));
   // utime is the first field: it sits right after the 8-byte type hash.
   int64_t utime_big_endian = 0;
-  for (int i = 0; i < 8; ++i) utime_big_endian = (utime_big_endian << 8) | buffer[8 + static_cast<size_t>(i)];
+  for (int i = 0; i < 8; ++i)
+    utime_big_endian = (utime_big_endian << 8) | buffer[8 + static_cast<size_t>(i)];
   EXPECT_EQ(utime_big_endian, in.utime);
   return out;
 }
@@ -82,11 +83,13 @@ TEST(Messages, VariableLengthDiagnosticsAndHealth) {
   d.h_position = {1e-3, 2e-3};
   d.alpha_h_position = {1e-3, 4e-3};
   d.w_position = {0.75, 0.25};
+  d.mu_position = {0.0, 0.0};
   d.num_velocity = 1;
   d.velocity_names = {"zd_upper"};
   d.h_velocity = {0.01};
   d.alpha_h_velocity = {0.02};
   d.w_velocity = {1.0};
+  d.mu_velocity = {0.0};
   d.active_case = safety_diagnostics_t::CASE_BOTH;
   d.compute_ns = 250;
   const safety_diagnostics_t d2 = RoundTrip(d);

@@ -26,9 +26,11 @@ void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
 namespace stewart::safety::test {
 namespace {
 
-long CountStepAllocations(bool force_limits, bool with_terms) {
+long CountStepAllocations(bool force_limits, bool with_terms,
+                          SafetyVariant variant = SafetyVariant::kClosedForm) {
   SafetyConfig config = RichSafetyConfig();
   config.force_limits_enabled = force_limits;
+  config.variant = variant;
   SafetyFilter filter(DefaultConfig().platform, config, DefaultConfig().actuators);
   std::mt19937 rng(1);
   std::vector<Vector6d> q, qd, f;
@@ -65,6 +67,12 @@ TEST(Allocation, CoreStepDoesNotAllocate) { EXPECT_EQ(CountStepAllocations(false
 TEST(Allocation, FullStepDoesNotAllocate) { EXPECT_EQ(CountStepAllocations(false, false), 0); }
 TEST(Allocation, ForceLimitedStepDoesNotAllocate) {
   EXPECT_EQ(CountStepAllocations(true, false), 0);
+}
+// The un-composed QP (up to 48 rows, fixed-size storage), with and without
+// force limits, including its infeasibility fallback.
+TEST(Allocation, UncomposedStepDoesNotAllocate) {
+  EXPECT_EQ(CountStepAllocations(false, false, SafetyVariant::kUncomposed), 0);
+  EXPECT_EQ(CountStepAllocations(true, false, SafetyVariant::kUncomposed), 0);
 }
 
 }  // namespace

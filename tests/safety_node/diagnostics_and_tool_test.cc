@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 #include <random>
 #include <string>
+#include <vector>
 
 #include "stewart/config/stack_config.h"
 #include "stewart/model/dynamics.h"
@@ -100,6 +101,35 @@ TEST(DiagnosticsMessage, CarriesEveryFilterQuantity) {
   EXPECT_GE(msg.psi_v + g_v.dot(f_safe - f_des), -1e-12);
 }
 
+TEST(DiagnosticsMessage, UncomposedCarriesEachBarriersMultiplier) {
+  SafetyConfig config = Config().safety;
+  config.variant = SafetyVariant::kUncomposed;
+  SafetyFilter filter(Config().platform, config, Config().actuators);
+  const Step s = ActiveStep();
+  SafetyDiagnostics d;
+  filter.Step(s.q, s.qd, s.f_des, &d);
+  ASSERT_GT(d.mu_v, 0.0);
+  safety_diagnostics_t msg{};
+  FillDiagnosticsMessage(filter, d, &msg);
+  EXPECT_EQ(msg.variant, +safety_diagnostics_t::VARIANT_UNCOMPOSED);
+  const ConstraintSet& c = filter.constraints();
+  ASSERT_EQ(msg.mu_position.size(), static_cast<size_t>(c.num_position));
+  ASSERT_EQ(msg.mu_velocity.size(), static_cast<size_t>(c.num_velocity));
+  double sum_mu_v = 0.0;
+  for (size_t k = 0; k < msg.mu_velocity.size(); ++k) {
+    EXPECT_EQ(msg.mu_velocity[k], d.mu_velocity[k]);
+    sum_mu_v += msg.mu_velocity[k];
+  }
+  for (size_t k = 0; k < msg.mu_position.size(); ++k) {
+    EXPECT_EQ(msg.mu_position[k], d.mu_position[k]);
+  }
+  EXPECT_NEAR(sum_mu_v, msg.mu_v, 1e-12 * msg.mu_v);
+  // It encodes: the arrays' sizes match their counts.
+  std::vector<uint8_t> buffer(static_cast<size_t>(msg.getEncodedSize()));
+  EXPECT_EQ(msg.encode(buffer.data(), 0, static_cast<int>(buffer.size())),
+            static_cast<int>(buffer.size()));
+}
+
 TEST(DiagnosticsMessage, ComputeNsIsTheTimeOfTheFullStep) {
   // Step reads the clock once around the model terms and the filter;
   // StepWithTerms (terms given, e.g. the benches and tests) is not timed.
@@ -135,7 +165,7 @@ nlohmann::json Line(const Step& s) {
 
 TEST(SafetyTool, PrintsWhatTheLibraryComputesForEveryVariant) {
   const Step s = ActiveStep();
-  for (const char* variant : {"closed_form", "paper", "qp"}) {
+  for (const char* variant : {"closed_form", "paper", "qp", "uncomposed"}) {
     const std::string out = RunTool(Line(s).dump() + "\n", std::string("--variant ") + variant);
     const nlohmann::json j = nlohmann::json::parse(out);
     SafetyConfig config = Config().safety;
@@ -154,6 +184,15 @@ TEST(SafetyTool, PrintsWhatTheLibraryComputesForEveryVariant) {
     }
     EXPECT_NEAR(j.at("mu_v").get<double>(), d.mu_v, 1e-12 * (1.0 + d.mu_v));
     EXPECT_TRUE(j.at("velocity").contains("zd_upper"));
+    if (config.variant == SafetyVariant::kUncomposed) {
+      // Each barrier's own multiplier, summing to the group's.
+      double sum_mu_v = 0.0;
+      for (const auto& [name, barrier] : j.at("velocity").items()) {
+        sum_mu_v += barrier.at("mu").get<double>();
+      }
+      EXPECT_NEAR(sum_mu_v, d.mu_v, 1e-12 * (1.0 + d.mu_v));
+      EXPECT_GT(d.mu_v, 0.0);
+    }
   }
 }
 

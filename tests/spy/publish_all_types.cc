@@ -78,11 +78,13 @@ int main(int argc, char** argv) {
     diag.h_position = {1e-3};
     diag.alpha_h_position = {1e-3};
     diag.w_position = {1.0};
+    diag.mu_position = {0.0};
     diag.num_velocity = 1;
     diag.velocity_names = {"xd_upper"};
     diag.h_velocity = {0.01};
     diag.alpha_h_velocity = {0.01};
     diag.w_velocity = {1.0};
+    diag.mu_velocity = {0.0};
     diag.compute_ns = 1500;
     lcm->publish(ch.safety_diagnostics, &diag);
 

@@ -64,11 +64,13 @@ TEST(LogExport, OneCsvPerChannel) {
     d.h_position = {0.1, 0.2};
     d.alpha_h_position = {0.1, 0.2};
     d.w_position = {0.75, 0.25};
+    d.mu_position = {0.0, 0.0};
     d.num_velocity = 1;
     d.velocity_names = {"zd_upper"};
     d.h_velocity = {0.01};
     d.alpha_h_velocity = {0.02};
     d.w_velocity = {1.0};
+    d.mu_velocity = {0.0};
     Append(&log, "T_DIAG", d, 70);
     lcm::LogEvent junk{};
     uint8_t bytes[4] = {1, 2, 3, 4};

@@ -55,6 +55,8 @@ SafetyVariant FromLcmVariant(int8_t v) {
       return SafetyVariant::kPaperRule;
     case safety_diagnostics_t::VARIANT_QP_REFERENCE:
       return SafetyVariant::kQpReference;
+    case safety_diagnostics_t::VARIANT_UNCOMPOSED:
+      return SafetyVariant::kUncomposed;
     default:
       return SafetyVariant::kClosedForm;
   }

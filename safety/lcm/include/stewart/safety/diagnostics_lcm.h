@@ -42,22 +42,26 @@ inline void FillDiagnosticsMessage(const SafetyFilter& filter, const SafetyDiagn
   msg->h_position.resize(static_cast<size_t>(c.num_position));
   msg->alpha_h_position.resize(static_cast<size_t>(c.num_position));
   msg->w_position.resize(static_cast<size_t>(c.num_position));
+  msg->mu_position.resize(static_cast<size_t>(c.num_position));
   for (size_t i = 0; i < static_cast<size_t>(c.num_position); ++i) {
     msg->position_names[i] = c.position[i].name;
     msg->h_position[i] = b.h_position[i];
     msg->alpha_h_position[i] = b.alpha_h_position[i];
     msg->w_position[i] = b.w_position[i];
+    msg->mu_position[i] = d.mu_position[i];
   }
   msg->num_velocity = c.num_velocity;
   msg->velocity_names.resize(static_cast<size_t>(c.num_velocity));
   msg->h_velocity.resize(static_cast<size_t>(c.num_velocity));
   msg->alpha_h_velocity.resize(static_cast<size_t>(c.num_velocity));
   msg->w_velocity.resize(static_cast<size_t>(c.num_velocity));
+  msg->mu_velocity.resize(static_cast<size_t>(c.num_velocity));
   for (size_t i = 0; i < static_cast<size_t>(c.num_velocity); ++i) {
     msg->velocity_names[i] = c.velocity[i].name;
     msg->h_velocity[i] = b.h_velocity[i];
     msg->alpha_h_velocity[i] = b.alpha_h_velocity[i];
     msg->w_velocity[i] = b.w_velocity[i];
+    msg->mu_velocity[i] = d.mu_velocity[i];
   }
   msg->h_pos = b.h_pos;
   msg->h_vel = b.h_vel;
