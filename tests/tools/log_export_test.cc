@@ -70,7 +70,7 @@ TEST(LogExport, OneCsvPerChannel) {
     d.h_velocity = {0.01};
     d.alpha_h_velocity = {0.02};
     d.w_velocity = {1.0};
-    d.mu_velocity = {0.0};
+    d.mu_velocity = {0.5};
     Append(&log, "T_DIAG", d, 70);
     lcm::LogEvent junk{};
     uint8_t bytes[4] = {1, 2, 3, 4};
@@ -108,6 +108,8 @@ TEST(LogExport, OneCsvPerChannel) {
   EXPECT_EQ(value("w_position0_"), "0.75");
   EXPECT_EQ(value("w_position1_"), "0.25");
   EXPECT_EQ(value("w_velocity0_"), "1");
+  EXPECT_EQ(value("mu_velocity0_"), "0.5");  // variant uncomposed's own multipliers
+  EXPECT_EQ(value("mu_position1_"), "0");
   EXPECT_EQ(value("h_position1_"), "0.20000000000000001");
   EXPECT_EQ(value("w_position23_"), "0");  // every column a config can have
   const auto barriers = Lines(dir + "/T_DIAG.barriers.csv");

@@ -141,7 +141,9 @@ class DiagnosticsWriter : public TypedWriter<safety_diagnostics_t> {
            "num_velocity" + IndexedColumns("h_position", kPositionColumns, "") +
            IndexedColumns("h_velocity", kVelocityColumns, "") +
            IndexedColumns("w_position", kPositionColumns, "") +
-           IndexedColumns("w_velocity", kVelocityColumns, "");
+           IndexedColumns("w_velocity", kVelocityColumns, "") +
+           IndexedColumns("mu_position", kPositionColumns, "") +
+           IndexedColumns("mu_velocity", kVelocityColumns, "");
   }
   void Row(const safety_diagnostics_t& m, std::ostream& out) const override {
     out << ',' << int{m.variant} << ',' << int{m.correction_metric} << ',' << int{m.active_case}
@@ -158,6 +160,8 @@ class DiagnosticsWriter : public TypedWriter<safety_diagnostics_t> {
     Values(out, m.h_velocity, kVelocityColumns);
     Values(out, m.w_position, kPositionColumns);
     Values(out, m.w_velocity, kVelocityColumns);
+    Values(out, m.mu_position, kPositionColumns);
+    Values(out, m.mu_velocity, kVelocityColumns);
   }
 };
 

@@ -146,7 +146,8 @@ def constraint_activity(run, config, diag, dt):
     conditions; a composed condition's correction is attributed to its
     barriers by their LSE weights w_i (they sum to 1): a barrier's active time
     is the sum of w_i * dt over the steps whose case activates its group. Also
-    the steps where it dominated the composition (w_i >= 0.5)."""
+    the steps where it dominated the composition (w_i >= 0.5). Variant
+    uncomposed: the steps where the barrier's own multiplier is positive."""
     lcm = config["lcm"]
     name = lcm["channel_prefix"] + lcm["channels"]["safety_diagnostics"] + \
         (lcm.get("channel_suffix") or "")
@@ -157,19 +158,35 @@ def constraint_activity(run, config, diag, dt):
         barriers = list(csv.DictReader(f))
     case = diag["active_case"]
     group_active = {"position": (case == 1) | (case == 3), "velocity": (case == 2) | (case == 3)}
-    lines = ["", "Time each constraint was active (its LSE weight's share of the active "
-             "composed condition; dominant: weight >= 0.5 while active):", "",
-             "| constraint | group | active time (s) | dominant steps |", "| --- | --- | --- | --- |"]
+    # Variant uncomposed has no composition: each barrier has its own
+    # condition and multiplier, active when that multiplier is positive.
+    uncomposed = "variant" in diag and len(diag["variant"]) > 0 and bool(np.all(diag["variant"] == 3))
+    if uncomposed:
+        lines = ["", "Time each constraint was active (variant uncomposed: its own condition's "
+                 "multiplier mu_i > 0):", "",
+                 "| constraint | group | active time (s) | active steps |", "| --- | --- | --- | --- |"]
+    else:
+        lines = ["", "Time each constraint was active (its LSE weight's share of the active "
+                 "composed condition; dominant: weight >= 0.5 while active):", "",
+                 "| constraint | group | active time (s) | dominant steps |",
+                 "| --- | --- | --- | --- |"]
     for b in barriers:
-        column = f"w_{b['group']}{b['index']}_"
-        if column not in diag:
-            continue
-        w = diag[column]
-        active = group_active[b["group"]]
-        time_s = float(np.sum(w[active])) * dt
-        dominant = int(np.sum(active & (w >= 0.5)))
-        if time_s > 0 or dominant:
-            lines.append(f"| {b['name']} | {b['group']} | {time_s:.2f} | {dominant} |")
+        if uncomposed:
+            column = f"mu_{b['group']}{b['index']}_"
+            if column not in diag:
+                continue
+            steps = int(np.sum(diag[column] > 0))
+            time_s, count = steps * dt, steps
+        else:
+            column = f"w_{b['group']}{b['index']}_"
+            if column not in diag:
+                continue
+            w = diag[column]
+            active = group_active[b["group"]]
+            time_s = float(np.sum(w[active])) * dt
+            count = int(np.sum(active & (w >= 0.5)))
+        if time_s > 0 or count:
+            lines.append(f"| {b['name']} | {b['group']} | {time_s:.2f} | {count} |")
     if len(lines) == 5:
         lines.append("| (none) | | 0 | 0 |")
     return lines
