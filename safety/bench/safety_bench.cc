@@ -55,6 +55,15 @@ void RunCore(benchmark::State& state, SafetyFilter* filter) {
   }
 }
 
+void RunFullStep(benchmark::State& state, SafetyFilter* filter) {
+  SafetyDiagnostics d;
+  size_t i = 0;
+  for (auto _ : state) {
+    const Sample& x = Samples()[i++ & 255];
+    benchmark::DoNotOptimize(filter->Step(x.q, x.qd, x.f_des, &d));
+  }
+}
+
 // (a) the closed form given the model terms.
 void BM_ClosedFormCore(benchmark::State& state) {
   SafetyFilter filter(Config().platform, Config().safety, Config().actuators);
@@ -84,12 +93,7 @@ BENCHMARK(BM_ClosedFormCoreActiveOnly);
 // (b) the full step including M, C qd, G, H.
 void BM_ClosedFormFullStep(benchmark::State& state) {
   SafetyFilter filter(Config().platform, Config().safety, Config().actuators);
-  SafetyDiagnostics d;
-  size_t i = 0;
-  for (auto _ : state) {
-    const Sample& s = Samples()[i++ & 255];
-    benchmark::DoNotOptimize(filter.Step(s.q, s.qd, s.f_des, &d));
-  }
+  RunFullStep(state, &filter);
 }
 BENCHMARK(BM_ClosedFormFullStep);
 
@@ -117,12 +121,7 @@ void BM_QpReferenceFullStep(benchmark::State& state) {
   SafetyConfig s = Config().safety;
   s.variant = SafetyVariant::kQpReference;
   SafetyFilter filter(Config().platform, s, Config().actuators, &solver);
-  SafetyDiagnostics d;
-  size_t i = 0;
-  for (auto _ : state) {
-    const Sample& x = Samples()[i++ & 255];
-    benchmark::DoNotOptimize(filter.Step(x.q, x.qd, x.f_des, &d));
-  }
+  RunFullStep(state, &filter);
 }
 BENCHMARK_TEMPLATE(BM_QpReferenceFullStep, ClpReferenceQp);
 #ifdef STEWART_HAVE_ALGLIB
@@ -134,12 +133,7 @@ void BM_ForceLimitedFullStep(benchmark::State& state) {
   SafetyConfig s = Config().safety;
   s.force_limits_enabled = true;
   SafetyFilter filter(Config().platform, s, Config().actuators);
-  SafetyDiagnostics d;
-  size_t i = 0;
-  for (auto _ : state) {
-    const Sample& x = Samples()[i++ & 255];
-    benchmark::DoNotOptimize(filter.Step(x.q, x.qd, x.f_des, &d));
-  }
+  RunFullStep(state, &filter);
 }
 BENCHMARK(BM_ForceLimitedFullStep);
 
@@ -150,12 +144,7 @@ void BM_UncomposedFullStep(benchmark::State& state) {
   s.variant = SafetyVariant::kUncomposed;
   s.force_limits_enabled = state.range(0) != 0;
   SafetyFilter filter(Config().platform, s, Config().actuators);
-  SafetyDiagnostics d;
-  size_t i = 0;
-  for (auto _ : state) {
-    const Sample& x = Samples()[i++ & 255];
-    benchmark::DoNotOptimize(filter.Step(x.q, x.qd, x.f_des, &d));
-  }
+  RunFullStep(state, &filter);
 }
 BENCHMARK(BM_UncomposedFullStep)->ArgName("force_limits")->Arg(0)->Arg(1);
 

@@ -286,15 +286,7 @@ bool SafetyFilter::BuildQp(const Matrix6d& map, const BarrierEvaluation& b, cons
   add_cbf(constraints_.num_velocity > 0 && !rows->drop_velocity, problem.psi_v, problem.g_v,
           &rows->v);
   rows->box = qp->m;
-  if (force_limits_) {
-    // F_i = T_i y within [-F_max, F_max].
-    for (int i = 0; i < kNumLegs; ++i) {
-      qp->a.row(qp->m) = map.row(i);  // F_i >= -F_max
-      qp->b(qp->m++) = -force_limit_n_;
-      qp->a.row(qp->m) = -map.row(i);  // F_i <= F_max
-      qp->b(qp->m++) = -force_limit_n_;
-    }
-  }
+  if (force_limits_) AppendForceLimitRows(map, force_limit_n_, qp);
   return posable;
 }
 

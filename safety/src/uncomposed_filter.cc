@@ -106,15 +106,7 @@ bool SafetyFilter::BuildUncomposedQp(const DynamicsTerms& terms, const Vector6d&
     }
   }
   rows->box = qp->m;
-  if (force_limits_) {
-    // F_i = T_i y within [-F_max, F_max], as BuildQp.
-    for (int i = 0; i < kNumLegs; ++i) {
-      qp->a.row(qp->m) = map.row(i);  // F_i >= -F_max
-      qp->b(qp->m++) = -force_limit_n_;
-      qp->a.row(qp->m) = -map.row(i);  // F_i <= F_max
-      qp->b(qp->m++) = -force_limit_n_;
-    }
-  }
+  if (force_limits_) AppendForceLimitRows(map, force_limit_n_, qp);
   return posable;
 }
 

@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <limits>
+#include <string>
 
 #include "safety_test_support.h"
 #include "stewart/safety/clp_reference_qp.h"
@@ -11,15 +12,12 @@
 namespace stewart::safety::test {
 namespace {
 
-SafetyFilter MakeFilter(bool force_limits = false) {
+SafetyFilter MakeFilter(bool force_limits = false,
+                        SafetyVariant variant = SafetyVariant::kClosedForm) {
   SafetyConfig s = RichSafetyConfig();
   s.force_limits_enabled = force_limits;
+  s.variant = variant;
   return SafetyFilter(DefaultConfig().platform, s, DefaultConfig().actuators);
-}
-
-Vector6d Hover(const Vector6d& q) {
-  const DynamicsTerms t = EvaluateDynamics(DefaultConfig().platform, q, Vector6d::Zero());
-  return t.H.partialPivLu().solve(t.G);
 }
 
 TEST(Degenerate, AtRestThePositionNormalIsZeroAndOnlyVelocityActs) {
@@ -46,14 +44,14 @@ TEST(Degenerate, AtRestOutsideThePositionSetIsInfeasibleAndFlagged) {
   Vector6d q = DefaultConfig().home_pose;
   q(0) = 0.12;  // beyond x <= 0.11: h_pos < 0 and g_p = 0
   SafetyDiagnostics d;
-  const Vector6d f = filter.Step(q, Vector6d::Zero(), Hover(q), &d);
+  const Vector6d f = filter.Step(q, Vector6d::Zero(), HoverForce(q), &d);
   EXPECT_TRUE(f.allFinite());
   EXPECT_LT(d.barriers.psi_p, 0.0);
   EXPECT_TRUE(d.infeasible);
   EXPECT_TRUE(d.flags & kFlagInfeasible);
   EXPECT_EQ(d.filter_case, FilterCase::kInfeasible);
   // The velocity condition is still enforced by the fallback.
-  EXPECT_GE(d.barriers.psi_v + d.barriers.g_v.dot(f - Hover(q)), -1e-12);
+  EXPECT_GE(d.barriers.psi_v + d.barriers.g_v.dot(f - HoverForce(q)), -1e-12);
 }
 
 TEST(Degenerate, ParallelNormals) {
@@ -101,31 +99,49 @@ TEST(Degenerate, NearlyParallelNormalsStayFiniteAndMatchTheReference) {
   }
 }
 
+// Closed form and un-composed QP, each unlimited and force-limited.
 TEST(Degenerate, NanOrInfInAnyInputGivesTheFlaggedSafeStop) {
-  SafetyFilter filter = MakeFilter();
-  const Vector6d q = DefaultConfig().home_pose;
-  const Vector6d qd = Vector6d::Constant(0.001);
-  const Vector6d f_des = Hover(q);
-  for (double bad :
-       {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()}) {
-    for (int which = 0; which < 3; ++which) {
-      for (int i = 0; i < 6; ++i) {
-        Vector6d in[3] = {q, qd, f_des};
-        in[which](i) = bad;
-        SafetyDiagnostics d;
-        const Vector6d f = filter.Step(in[0], in[1], in[2], &d);
-        EXPECT_TRUE(f.allFinite()) << which << " " << i;
-        EXPECT_TRUE(d.flags & kFlagInvalidInput);
-        EXPECT_TRUE(d.flags & kFlagFallback);
-        EXPECT_EQ(d.filter_case, FilterCase::kFallback);
-        EXPECT_TRUE(std::isfinite(d.correction_norm));
-        EXPECT_TRUE(std::isfinite(d.barriers.psi_p) && std::isfinite(d.barriers.psi_v));
-        if (which == 2) {
-          // q, qd valid: the hold brake decelerates, qdd = -qd / stop_time.
-          const DynamicsTerms t = EvaluateDynamics(DefaultConfig().platform, q, qd);
-          EXPECT_LE((ForwardDynamics(t, f) + qd / DefaultConfig().safety.stop_time_s).norm(), 1e-9);
+  for (const SafetyVariant variant : {SafetyVariant::kClosedForm, SafetyVariant::kUncomposed}) {
+    for (const bool force_limits : {false, true}) {
+      SafetyFilter filter = MakeFilter(force_limits, variant);
+      const Vector6d q = DefaultConfig().home_pose;
+      const Vector6d qd = Vector6d::Constant(0.001);
+      const Vector6d f_des = HoverForce(q);
+      const std::string where = ToString(variant) + (force_limits ? " force-limited" : "");
+      for (double bad :
+           {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()}) {
+        for (int which = 0; which < 3; ++which) {
+          for (int i = 0; i < 6; ++i) {
+            Vector6d in[3] = {q, qd, f_des};
+            in[which](i) = bad;
+            SafetyDiagnostics d;
+            const Vector6d f = filter.Step(in[0], in[1], in[2], &d);
+            EXPECT_TRUE(f.allFinite()) << where << " " << which << " " << i;
+            EXPECT_TRUE(d.flags & kFlagInvalidInput) << where;
+            EXPECT_TRUE(d.flags & kFlagFallback) << where;
+            EXPECT_EQ(d.filter_case, FilterCase::kFallback) << where;
+            EXPECT_TRUE(std::isfinite(d.correction_norm)) << where;
+            EXPECT_TRUE(std::isfinite(d.barriers.psi_p) && std::isfinite(d.barriers.psi_v));
+            EXPECT_EQ(d.mu_p, 0.0) << where;
+            EXPECT_EQ(d.mu_v, 0.0) << where;
+            for (double mu : d.mu_position) EXPECT_EQ(mu, 0.0) << where;
+            for (double mu : d.mu_velocity) EXPECT_EQ(mu, 0.0) << where;
+            if (which == 2 && !force_limits) {
+              // q, qd valid: the hold brake decelerates, qdd = -qd / stop_time.
+              const DynamicsTerms t = EvaluateDynamics(DefaultConfig().platform, q, qd);
+              EXPECT_LE((ForwardDynamics(t, f) + qd / DefaultConfig().safety.stop_time_s).norm(),
+                        1e-9)
+                  << where;
+            }
+          }
         }
       }
+      // Beyond kMaxInputForceN: rejected as invalid, safe stop.
+      SafetyDiagnostics d;
+      const Vector6d f = filter.Step(q, qd, Vector6d::Constant(1e300), &d);
+      EXPECT_TRUE(f.allFinite()) << where;
+      EXPECT_TRUE(d.flags & kFlagInvalidInput) << where;
+      EXPECT_LT(f.norm(), 1e3) << where;
     }
   }
 }
@@ -157,7 +173,7 @@ TEST(Degenerate, ForceLimitsThatMakeTheConditionsInfeasibleAreReported) {
   SafetyFilter filter(DefaultConfig().platform, s, weak);
   const Vector6d q = DefaultConfig().home_pose;
   SafetyDiagnostics d;
-  const Vector6d f = filter.Step(q, Vector6d::Zero(), Hover(q), &d);
+  const Vector6d f = filter.Step(q, Vector6d::Zero(), HoverForce(q), &d);
   EXPECT_TRUE(f.allFinite());
   EXPECT_TRUE(d.infeasible);
   EXPECT_TRUE(d.flags & kFlagInfeasible);

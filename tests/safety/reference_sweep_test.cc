@@ -35,10 +35,11 @@ void Sweep(ReferenceQpSolver* reference, bool force_limits, CorrectionMetric met
   int paper_differs = 0, both_infeasible = 0;
   double worst = 0.0;
   for (int n = 0; n < samples; ++n) {
-    const Vector6d q = RandomPoseInLimits(&rng);
-    const Vector6d qd = RandomVelocity(&rng);
-    const DynamicsTerms terms = EvaluateDynamics(DefaultConfig().platform, q, qd);
-    const Vector6d f_des = RandomNominalForce(terms, &rng);
+    const FilterInput x = RandomFilterInput(&rng);
+    const Vector6d& q = x.q;
+    const Vector6d& qd = x.qd;
+    const DynamicsTerms& terms = x.terms;
+    const Vector6d& f_des = x.f_des;
     SafetyDiagnostics d;
     const Vector6d f = filter.StepWithTerms(terms, q, qd, f_des, &d);
     ++cases[static_cast<size_t>(d.filter_case)];

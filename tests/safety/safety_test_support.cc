@@ -1,5 +1,7 @@
 #include "safety_test_support.h"
 
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <cmath>
 
@@ -83,6 +85,37 @@ Vector6d RandomNominalForce(const DynamicsTerms& terms, std::mt19937* rng) {
 
 double RelativeError(const Vector6d& a, const Vector6d& b) {
   return (a - b).norm() / std::max(b.norm(), 1.0);
+}
+
+void ExpectForceLimitsKkt(const Vector6d& f, const Vector6d& mu_force, bool force_limits,
+                          double f_max_n, int sample) {
+  if (!force_limits) {
+    EXPECT_EQ(mu_force, Vector6d::Zero()) << "sample " << sample;
+    return;
+  }
+  for (int i = 0; i < 6; ++i) {
+    EXPECT_LE(std::fabs(f(i)), f_max_n * (1 + 1e-12)) << "sample " << sample;
+    if (mu_force(i) > 0) {
+      EXPECT_NEAR(f(i), f_max_n, 1e-9 * f_max_n) << "sample " << sample;
+    }
+    if (mu_force(i) < 0) {
+      EXPECT_NEAR(f(i), -f_max_n, 1e-9 * f_max_n) << "sample " << sample;
+    }
+  }
+}
+
+FilterInput RandomFilterInput(std::mt19937* rng) {
+  FilterInput x;
+  x.q = RandomPoseInLimits(rng);
+  x.qd = RandomVelocity(rng);
+  x.terms = EvaluateDynamics(DefaultConfig().platform, x.q, x.qd);
+  x.f_des = RandomNominalForce(x.terms, rng);
+  return x;
+}
+
+Vector6d HoverForce(const Vector6d& q) {
+  const DynamicsTerms t = EvaluateDynamics(DefaultConfig().platform, q, Vector6d::Zero());
+  return t.H.partialPivLu().solve(t.G);
 }
 
 }  // namespace stewart::safety::test

@@ -22,6 +22,23 @@ Vector6d RandomVelocity(std::mt19937* rng);
 /// size (1e-3 .. 10 m/s^2), so every case of the QP occurs.
 Vector6d RandomNominalForce(const DynamicsTerms& terms, std::mt19937* rng);
 
+/// KKT of the force limits on an output F*: |F_i| <= f_max_n, and a
+/// non-zero multiplier only on a limit that holds with equality (sign: +
+/// upper, - lower); all zero without force limits. gtest EXPECTs.
+void ExpectForceLimitsKkt(const Vector6d& f, const Vector6d& mu_force, bool force_limits,
+                          double f_max_n, int sample);
+
+/// One filter input with its model terms.
+struct FilterInput {
+  Vector6d q, qd, f_des;
+  DynamicsTerms terms;
+};
+/// RandomPoseInLimits, RandomVelocity, the terms there, RandomNominalForce.
+FilterInput RandomFilterInput(std::mt19937* rng);
+
+/// The leg forces that hold the platform at rest at q (H F = G).
+Vector6d HoverForce(const Vector6d& q);
+
 /// Relative difference ||a - b|| / max(||b||, 1 N).
 double RelativeError(const Vector6d& a, const Vector6d& b);
 

@@ -60,10 +60,7 @@ void Sweep(bool force_limits, CorrectionMetric metric, int samples, Draw draw,
                            : DrawNearOneLimit(&rng, &x);
     }
     if (!drawn) {
-      x.q = RandomPoseInLimits(&rng);
-      x.qd = RandomVelocity(&rng);
-      x.terms = EvaluateDynamics(DefaultConfig().platform, x.q, x.qd);
-      x.f_des = RandomNominalForce(x.terms, &rng);
+      x = RandomFilterInput(&rng);
     }
     SafetyDiagnostics d;
     const Vector6d f = filter.StepWithTerms(x.terms, x.q, x.qd, x.f_des, &d);

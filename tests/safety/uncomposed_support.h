@@ -52,10 +52,7 @@ inline SingleBarrierConditions EvaluateSingleBarrierConditions(const SafetyFilte
 // below its limit) and the nominal force accelerates it further (1e-3 ..
 // 1 m/s^2, log-uniform), every other axis slow, near the middle of its range
 // and hardly accelerated.
-struct NearOneLimit {
-  Vector6d q, qd, f_des;
-  DynamicsTerms terms;
-};
+using NearOneLimit = FilterInput;
 
 inline bool DrawNearOneLimit(std::mt19937* rng, NearOneLimit* out) {
   const SafetyConfig s = RichSafetyConfig();

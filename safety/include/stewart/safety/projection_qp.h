@@ -54,4 +54,16 @@ ProjectionResultN<MaxRows> SolveProjectionQp(const ProjectionQpN<MaxRows>& qp);
 
 extern template ProjectionResultN<kMaxQpRows> SolveProjectionQp(const ProjectionQpN<kMaxQpRows>&);
 
+/// Appends the force-limit rows |F_i| <= f_max_n of F = T y (T = metric_map,
+/// docs/safety.md): per leg i, T_i y >= -f_max_n then -T_i y >= -f_max_n.
+template <int MaxRows>
+void AppendForceLimitRows(const Matrix6d& metric_map, double f_max_n, ProjectionQpN<MaxRows>* qp) {
+  for (int i = 0; i < kNumLegs; ++i) {
+    qp->a.row(qp->m) = metric_map.row(i);
+    qp->b(qp->m++) = -f_max_n;
+    qp->a.row(qp->m) = -metric_map.row(i);
+    qp->b(qp->m++) = -f_max_n;
+  }
+}
+
 }  // namespace stewart::safety
