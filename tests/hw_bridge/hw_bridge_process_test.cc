@@ -146,8 +146,18 @@ void ExpectSaneSamples(const Stack& stack, std::size_t held) {
         EXPECT_NEAR(s.leg_length_m[i], home_lengths(i), 2e-3);
       }
     }
-    EXPECT_NEAR(s.accel_mps2[2], p.gravity_mps2, 5.0);
-    EXPECT_LT(std::abs(s.gyro_radps[0]), 0.5);
+    for (int i = 0; i < 3; ++i) {
+      ASSERT_TRUE(std::isfinite(s.accel_mps2[i]) && std::isfinite(s.gyro_radps[i]));
+    }
+    // The IMU is checked where the platform is held still. When the commands
+    // stop and the device zeroes the drive, the lead screws lock the moving
+    // legs (Plant's lock: the end-stop spring and damper, c / m ~ 7000 1/s):
+    // a sample that falls in that sub-millisecond transient truly reads a
+    // deceleration of a g or more (seen once in ~20 runs: a_z = -4.2 m/s^2).
+    if (k < held) {
+      EXPECT_NEAR(s.accel_mps2[2], p.gravity_mps2, 1.0) << "sample " << k;
+      EXPECT_LT(std::abs(s.gyro_radps[0]), 0.1) << "sample " << k;
+    }
     EXPECT_EQ(s.status & sensor_t::STATUS_LEG_FAULT, 0);
   }
 }
