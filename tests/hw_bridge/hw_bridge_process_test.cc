@@ -151,7 +151,7 @@ void ExpectSaneSamples(const Stack& stack, std::size_t held) {
     }
     // The IMU is checked where the platform is held still. When the commands
     // stop and the device zeroes the drive, the lead screws lock the moving
-    // legs (Plant's lock: the end-stop spring and damper, c / m ~ 7000 1/s):
+    // legs (Plant's lock: the end-stop spring and damper, c / m ~ 1e4 1/s):
     // a sample that falls in that sub-millisecond transient truly reads a
     // deceleration of a g or more (measured: in ~1 of 30 runs, up to 5 g, at
     // the sample where the lock engages).
