@@ -322,7 +322,7 @@ void SafetyFilter::SolveForceLimited(const DynamicsTerms& terms, const Vector6d&
     }
     if ((d->mu_force.array() != 0.0).any()) d->flags |= kFlagForceLimited;
   }
-  d->f_safe = ForceFromQpSolution(map, r.x);
+  d->f_safe = ForceFromQpSolution(map, r.x, qp.x0, f_des);
   d->filter_case = d->infeasible ? FilterCase::kInfeasible : CaseFromMultipliers(d->mu_p, d->mu_v);
 }
 

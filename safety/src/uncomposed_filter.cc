@@ -220,11 +220,7 @@ void SafetyFilter::SolveUncomposed(const DynamicsTerms& terms, const Vector6d& q
     }
     if ((d->mu_force.array() != 0.0).any()) d->flags |= kFlagForceLimited;
   }
-  // No row active: F_des itself, not its round trip through y = T^-1 F
-  // (which differs by rounding and would count as an intervention).
-  const bool untouched =
-      !d->infeasible && mu_p == 0.0 && mu_v == 0.0 && (d->mu_force.array() == 0.0).all();
-  d->f_safe = untouched ? f_des : ForceFromQpSolution(map, y);
+  d->f_safe = ForceFromQpSolution(map, y, qp.x0, f_des);
   d->filter_case = d->infeasible ? FilterCase::kInfeasible : CaseFromGroups(mu_p, mu_v);
 }
 

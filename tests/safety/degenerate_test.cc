@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <limits>
+#include <random>
 #include <string>
 
 #include "safety_test_support.h"
@@ -11,14 +12,6 @@
 
 namespace stewart::safety::test {
 namespace {
-
-SafetyFilter MakeFilter(bool force_limits = false,
-                        SafetyVariant variant = SafetyVariant::kClosedForm) {
-  SafetyConfig s = RichSafetyConfig();
-  s.force_limits_enabled = force_limits;
-  s.variant = variant;
-  return SafetyFilter(DefaultConfig().platform, s, DefaultConfig().actuators);
-}
 
 TEST(Degenerate, AtRestThePositionNormalIsZeroAndOnlyVelocityActs) {
   // Upper limits only (the paper's set): with a lower and an upper limit on
@@ -40,7 +33,7 @@ TEST(Degenerate, AtRestThePositionNormalIsZeroAndOnlyVelocityActs) {
 }
 
 TEST(Degenerate, AtRestOutsideThePositionSetIsInfeasibleAndFlagged) {
-  SafetyFilter filter = MakeFilter();
+  SafetyFilter filter = MakeRichFilter();
   Vector6d q = DefaultConfig().home_pose;
   q(0) = 0.12;  // beyond x <= 0.11: h_pos < 0 and g_p = 0
   SafetyDiagnostics d;
@@ -103,7 +96,7 @@ TEST(Degenerate, NearlyParallelNormalsStayFiniteAndMatchTheReference) {
 TEST(Degenerate, NanOrInfInAnyInputGivesTheFlaggedSafeStop) {
   for (const SafetyVariant variant : {SafetyVariant::kClosedForm, SafetyVariant::kUncomposed}) {
     for (const bool force_limits : {false, true}) {
-      SafetyFilter filter = MakeFilter(force_limits, variant);
+      SafetyFilter filter = MakeRichFilter(force_limits, variant);
       const Vector6d q = DefaultConfig().home_pose;
       const Vector6d qd = Vector6d::Constant(0.001);
       const Vector6d f_des = HoverForce(q);
@@ -147,7 +140,7 @@ TEST(Degenerate, NanOrInfInAnyInputGivesTheFlaggedSafeStop) {
 }
 
 TEST(Degenerate, HugeNominalForce) {
-  SafetyFilter filter = MakeFilter();
+  SafetyFilter filter = MakeRichFilter();
   const Vector6d q = DefaultConfig().home_pose;
   SafetyDiagnostics d;
   // Large but representable: filtered normally, strongly corrected.
@@ -178,6 +171,29 @@ TEST(Degenerate, ForceLimitsThatMakeTheConditionsInfeasibleAreReported) {
   EXPECT_TRUE(d.infeasible);
   EXPECT_TRUE(d.flags & kFlagInfeasible);
   EXPECT_LE(f.cwiseAbs().maxCoeff(), 0.5 + 1e-12);
+}
+
+// The QP-based variants return F_des itself, bit for bit, when no row acts:
+// not T T^-1 F_des, which differs by rounding and would read as an
+// intervention (active time, correction norm).
+TEST(Degenerate, NoActiveRowPassesFDesExactly) {
+  for (const SafetyVariant variant : {SafetyVariant::kClosedForm, SafetyVariant::kUncomposed}) {
+    for (const bool force_limits : {false, true}) {
+      SafetyFilter filter = MakeRichFilter(force_limits, variant);
+      std::mt19937 rng(53);
+      int untouched = 0;
+      for (int n = 0; n < 2000; ++n) {
+        const FilterInput x = RandomFilterInput(&rng);
+        SafetyDiagnostics d;
+        const Vector6d f = filter.StepWithTerms(x.terms, x.q, x.qd, x.f_des, &d);
+        if (d.filter_case != FilterCase::kNone || (d.mu_force.array() != 0.0).any()) continue;
+        ++untouched;
+        EXPECT_TRUE(f == x.f_des) << ToString(variant) << " " << force_limits << " sample " << n;
+        EXPECT_EQ(d.correction_norm, 0.0);
+      }
+      EXPECT_GT(untouched, 100) << ToString(variant) << " " << force_limits;
+    }
+  }
 }
 
 }  // namespace

@@ -118,4 +118,11 @@ Vector6d HoverForce(const Vector6d& q) {
   return t.H.partialPivLu().solve(t.G);
 }
 
+SafetyFilter MakeRichFilter(bool force_limits, SafetyVariant variant) {
+  SafetyConfig s = RichSafetyConfig();
+  s.force_limits_enabled = force_limits;
+  s.variant = variant;
+  return SafetyFilter(DefaultConfig().platform, s, DefaultConfig().actuators);
+}
+
 }  // namespace stewart::safety::test

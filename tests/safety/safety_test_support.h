@@ -28,6 +28,10 @@ Vector6d RandomNominalForce(const DynamicsTerms& terms, std::mt19937* rng);
 void ExpectForceLimitsKkt(const Vector6d& f, const Vector6d& mu_force, bool force_limits,
                           double f_max_n, int sample);
 
+/// A filter on the rich config with this variant and force-limit switch.
+SafetyFilter MakeRichFilter(bool force_limits = false,
+                            SafetyVariant variant = SafetyVariant::kClosedForm);
+
 /// One filter input with its model terms.
 struct FilterInput {
   Vector6d q, qd, f_des;

@@ -227,15 +227,9 @@ TEST(Uncomposed, AgreesWithTheComposedFilterAsKGrows) {
   }
 }
 
-SafetyFilter MakeFilter(bool force_limits = false) {
-  return SafetyFilter(DefaultConfig().platform,
-                      UncomposedConfig(force_limits, DefaultConfig().safety.correction_metric),
-                      DefaultConfig().actuators);
-}
-
 TEST(UncomposedDegenerate, AtRestOnlyVelocityRowsAct) {
   // qd = 0: every position row has a zero normal (left out, all met inside).
-  SafetyFilter filter = MakeFilter();
+  SafetyFilter filter = MakeRichFilter(false, SafetyVariant::kUncomposed);
   const Vector6d q = DefaultConfig().home_pose;
   const DynamicsTerms t = EvaluateDynamics(DefaultConfig().platform, q, Vector6d::Zero());
   const Vector6d f_des = InverseDynamics(t, Vector6d::Unit(0) * 20.0);
@@ -264,7 +258,7 @@ TEST(UncomposedDegenerate, AtRestOutsideThePositionSetIsInfeasibleAndFlagged) {
   // Hover, and a push along +x that the velocity rows must stop.
   for (const Vector6d& f_des :
        {HoverForce(q), Vector6d(InverseDynamics(t, Vector6d::Unit(0) * 5.0))}) {
-    SafetyFilter filter = MakeFilter();
+    SafetyFilter filter = MakeRichFilter(false, SafetyVariant::kUncomposed);
     SafetyDiagnostics d;
     const Vector6d f = filter.Step(q, Vector6d::Zero(), f_des, &d);
     EXPECT_TRUE(f.allFinite());
@@ -278,7 +272,7 @@ TEST(UncomposedDegenerate, AtRestOutsideThePositionSetIsInfeasibleAndFlagged) {
       EXPECT_GE(at_f.psi_velocity[static_cast<size_t>(i)], -1e-9);
     }
     // Force-limited: as the composed force-limited filter, the safe stop.
-    SafetyFilter limited = MakeFilter(true);
+    SafetyFilter limited = MakeRichFilter(true, SafetyVariant::kUncomposed);
     const Vector6d fl = limited.Step(q, Vector6d::Zero(), f_des, &d);
     EXPECT_TRUE(fl.allFinite());
     EXPECT_TRUE(d.flags & kFlagFallback);
@@ -321,7 +315,7 @@ TEST(UncomposedDegenerate, EmptyVelocitySlabKeepsThePositionRows) {
 // NaN/Inf inputs: Degenerate.NanOrInfInAnyInputGivesTheFlaggedSafeStop covers this variant.
 
 TEST(UncomposedDegenerate, HugeNominalForceIsCorrectedAndFinite) {
-  SafetyFilter filter = MakeFilter();
+  SafetyFilter filter = MakeRichFilter(false, SafetyVariant::kUncomposed);
   const Vector6d q = DefaultConfig().home_pose;
   const Vector6d qd = Vector6d::Constant(0.001);
   SafetyDiagnostics d;

@@ -89,6 +89,13 @@ class SafetyFilter {
   static Vector6d ForceFromQpSolution(const Matrix6d& metric_map, const Vector6d& y) {
     return metric_map * y;
   }
+  /// The filter's output from the exact solver's y: F_des itself when the
+  /// solver left y0 = T^-1 F_des as it was (no row violated), since T T^-1
+  /// F_des differs from F_des by rounding and would read as an intervention.
+  static Vector6d ForceFromQpSolution(const Matrix6d& metric_map, const Vector6d& y,
+                                      const Vector6d& y0, const Vector6d& f_des) {
+    return y == y0 ? f_des : ForceFromQpSolution(metric_map, y);
+  }
 
   void set_variant(SafetyVariant variant);
   SafetyVariant variant() const { return variant_; }
