@@ -6,7 +6,7 @@
 namespace stewart {
 
 ConfigError::ConfigError(const std::string& key, const std::string& reason)
-    : std::runtime_error("config error at '" + key + "': " + reason), key_(key), reason_(reason) {}
+    : InputError(key, reason, "config error at '" + key + "': " + reason) {}
 
 ConfigNode::ConfigNode(YAML::Node node, std::string path)
     : node_(std::move(node)), path_(std::move(path)) {}

@@ -1,4 +1,4 @@
-#include "stewart/config/controller_config.h"
+#include "stewart/config/sections.h"
 
 namespace stewart {
 

@@ -1,4 +1,4 @@
-#include "stewart/config/estimator_config.h"
+#include "stewart/config/sections.h"
 
 namespace stewart {
 

@@ -1,4 +1,4 @@
-#include "stewart/config/hw_bridge_config.h"
+#include "stewart/config/sections.h"
 
 #include <cmath>
 

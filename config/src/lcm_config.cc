@@ -1,25 +1,6 @@
-#include "stewart/config/lcm_config.h"
+#include "stewart/config/sections.h"
 
 namespace stewart {
-namespace {
-
-struct ChannelField {
-  const char* key;
-  std::string ChannelNames::*member;
-};
-constexpr ChannelField kChannelFields[] = {
-    {"sensors", &ChannelNames::sensors},
-    {"state_estimate", &ChannelNames::state_estimate},
-    {"state_truth", &ChannelNames::state_truth},
-    {"setpoint", &ChannelNames::setpoint},
-    {"command_nominal", &ChannelNames::command_nominal},
-    {"command_safe", &ChannelNames::command_safe},
-    {"safety_diagnostics", &ChannelNames::safety_diagnostics},
-    {"health", &ChannelNames::health},
-};
-
-}  // namespace
-
 LcmConfig ParseLcmConfig(const ConfigNode& lcm, const ConfigNode& rates) {
   LcmConfig c;
   c.url = lcm.String("url");
@@ -40,14 +21,6 @@ LcmConfig ParseLcmConfig(const ConfigNode& lcm, const ConfigNode& rates) {
   SetChannelSuffix(&c, suffix);
   c.health_rate_hz = rates.PositiveDouble("health_hz");
   return c;
-}
-
-void SetChannelSuffix(LcmConfig* lcm, const std::string& suffix) {
-  for (const ChannelField& field : kChannelFields) {
-    std::string& name = lcm->channels.*field.member;
-    name = name.substr(0, name.size() - lcm->channel_suffix.size()) + suffix;
-  }
-  lcm->channel_suffix = suffix;
 }
 
 }  // namespace stewart

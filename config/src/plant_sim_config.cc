@@ -1,4 +1,4 @@
-#include "stewart/config/plant_sim_config.h"
+#include "stewart/config/sections.h"
 
 namespace stewart {
 

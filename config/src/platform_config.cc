@@ -1,4 +1,4 @@
-#include "stewart/config/platform_config.h"
+#include "stewart/config/sections.h"
 
 namespace stewart {
 

@@ -1,4 +1,4 @@
-#include "stewart/config/safety_config.h"
+#include "stewart/config/sections.h"
 
 #include <stdexcept>
 
@@ -25,43 +25,10 @@ void ParseBounds(const ConfigNode& node, Limit* limit) {
 
 }  // namespace
 
-std::string ToString(SafetyVariant variant) {
-  switch (variant) {
-    case SafetyVariant::kClosedForm:
-      return "closed_form";
-    case SafetyVariant::kPaperRule:
-      return "paper";
-    case SafetyVariant::kQpReference:
-      return "qp";
-    case SafetyVariant::kUncomposed:
-      return "uncomposed";
-  }
-  return "?";
-}
-
-SafetyVariant ParseSafetyVariant(const std::string& name) {
-  if (name == "closed_form") return SafetyVariant::kClosedForm;
-  if (name == "paper") return SafetyVariant::kPaperRule;
-  if (name == "qp") return SafetyVariant::kQpReference;
-  if (name == "uncomposed") return SafetyVariant::kUncomposed;
-  throw std::invalid_argument("unknown safety variant '" + name +
-                              "' (closed_form | paper | qp | uncomposed)");
-}
-
-std::string ToString(CorrectionMetric metric) {
-  return metric == CorrectionMetric::kAcceleration ? "acceleration" : "force";
-}
-
-CorrectionMetric ParseCorrectionMetric(const std::string& name) {
-  if (name == "force") return CorrectionMetric::kForce;
-  if (name == "acceleration") return CorrectionMetric::kAcceleration;
-  throw std::invalid_argument("unknown correction metric '" + name + "' (force | acceleration)");
-}
-
 SafetyConfig ParseSafetyConfig(const ConfigNode& safety) {
   SafetyConfig s;
   s.variant =
-      ParseSafetyVariant(safety.Choice("variant", {"closed_form", "paper", "qp", "uncomposed"}));
+      safety.EnumValue("variant", kSafetyVariantNames);
   s.k_position = safety.PositiveDouble("k_position");
   s.k_velocity = safety.PositiveDouble("k_velocity");
   for (const ConfigNode& node : safety.List("position_limits")) {
@@ -92,15 +59,14 @@ SafetyConfig ParseSafetyConfig(const ConfigNode& safety) {
   s.leg_stroke.alpha = leg.PositiveDouble("alpha");
   s.force_limits_enabled = safety.Bool("force_limits_enabled");
   s.stale_age_s = safety.PositiveDouble("stale_age_s");
-  s.fallback = safety.Choice("fallback", {"hold", "zero"}) == "hold" ? SafetyFallback::kHold
-                                                                     : SafetyFallback::kZero;
+  s.fallback = safety.EnumValue("fallback", kSafetyFallbackNames);
   if (const std::optional<double> stop = safety.OptionalDouble("stop_time_s")) {
     if (!(*stop > 0.0)) safety.Fail("stop_time_s", "must be positive");
     s.stop_time_s = *stop;
   }
   if (safety.Has("correction_metric")) {
     s.correction_metric =
-        ParseCorrectionMetric(safety.Choice("correction_metric", {"force", "acceleration"}));
+        safety.EnumValue("correction_metric", kCorrectionMetricNames);
   }
   if (safety.Has("velocity_robust_margin_mps2")) {
     s.velocity_robust_margin_mps2 = safety.NonNegativeDouble("velocity_robust_margin_mps2");

@@ -1,13 +1,8 @@
-#include "stewart/config/sensor_config.h"
+#include "stewart/config/sections.h"
 
 #include <cmath>
 
 namespace stewart {
-
-double LegAdcStepM(const SensorConfig& sensors, double stroke_m) {
-  if (sensors.leg_adc_bits <= 0) return 0.0;
-  return stroke_m / (std::ldexp(1.0, sensors.leg_adc_bits) - 1.0);
-}
 
 SensorConfig ParseSensorConfig(const ConfigNode& sensors) {
   SensorConfig s;

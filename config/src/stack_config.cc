@@ -1,4 +1,5 @@
-#include "stewart/config/stack_config.h"
+#include "stewart/config/config_loader.h"
+#include "stewart/config/sections.h"
 
 #include <cmath>
 #include <cstdlib>

@@ -22,10 +22,10 @@ Setpoint FromMessage(const setpoint_t& msg) {
 
 }  // namespace
 
-ControllerNode::ControllerNode(const StackConfig& config, std::optional<Scenario> scenario,
-                               bool exit_at_end)
+ControllerNode::ControllerNode(const StackConfig& config, lcm::LCM* lcm,
+                               std::optional<Scenario> scenario, bool exit_at_end)
     : config_(config),
-      lcm_(MakeLcm(config.lcm.url)),
+      lcm_(lcm),
       receiver_(config.lcm.url),
       controller_(config.platform, config.controller, config.home_pose, std::move(scenario)),
       health_("controller", config.lcm.channels.health, config.lcm.health_rate_hz),
@@ -81,14 +81,13 @@ void ControllerNode::OnState(const lcm::ReceiveBuffer*, const std::string&, cons
   health_.SetState(out.setpoint_rejected ? health_t::STATE_DEGRADED : health_t::STATE_OK);
 }
 
-int ControllerNode::Run() {
-  InstallStopSignalHandlers();
+ExitCode ControllerNode::Run() {
   const auto& ch = config_.lcm.channels;
   spdlog::info("controller: {} -> {}{} on {}", ch.state_estimate, ch.command_nominal,
                controller_.following_scenario() ? " + " + ch.setpoint
                                                 : " (live setpoints on " + ch.setpoint + ")",
                config_.lcm.url);
-  return RunNodeLoop("controller", lcm_.get(), &receiver_, &health_, kPollMs, [this] {
+  return RunNodeLoop("controller", lcm_, &receiver_, &health_, kPollMs, [this] {
     if (!exit_at_end_ || !controller_.scenario_finished()) return false;
     spdlog::info("controller: scenario '{}' finished", controller_.scenario()->name());
     return true;

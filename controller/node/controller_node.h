@@ -8,6 +8,7 @@
 #include "stewart/config/stack_config.h"
 #include "stewart/controller/controller.h"
 #include "stewart/force_command_t.hpp"
+#include "stewart/node/exit_code.h"
 #include "stewart/node/health_reporter.h"
 #include "stewart/node/lcm_receiver.h"
 #include "stewart/setpoint_t.hpp"
@@ -17,10 +18,11 @@ namespace stewart {
 
 class ControllerNode {
  public:
-  ControllerNode(const StackConfig& config, std::optional<Scenario> scenario, bool exit_at_end);
+  ControllerNode(const StackConfig& config, lcm::LCM* lcm, std::optional<Scenario> scenario,
+                 bool exit_at_end);
 
   /// Runs until a stop signal, or the scenario's end with exit_at_end.
-  int Run();
+  ExitCode Run();
 
   void OnState(const lcm::ReceiveBuffer* rbuf, const std::string& channel, const state_t* msg);
   void OnSetpoint(const lcm::ReceiveBuffer* rbuf, const std::string& channel,
@@ -28,7 +30,7 @@ class ControllerNode {
 
  private:
   StackConfig config_;
-  std::unique_ptr<lcm::LCM> lcm_;
+  lcm::LCM* lcm_;
   LcmReceiver receiver_;
   Controller controller_;
   HealthReporter health_;

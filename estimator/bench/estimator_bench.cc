@@ -4,7 +4,7 @@
 
 #include <cmath>
 
-#include "stewart/config/stack_config.h"
+#include "stewart/config/config_loader.h"
 #include "stewart/estimator/ekf.h"
 #include "stewart/model/dynamics.h"
 #include "stewart/model/imu.h"

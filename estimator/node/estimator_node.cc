@@ -87,6 +87,6 @@ void EstimatorNode::Publish(const state_t& msg) {
   health_.MaybePublish(lcm_);
 }
 
-int EstimatorNode::Run() { return RunNodeLoop("estimator", lcm_, &receiver_, &health_, 100); }
+ExitCode EstimatorNode::Run() { return RunNodeLoop("estimator", lcm_, &receiver_, &health_, 100); }
 
 }  // namespace stewart

@@ -9,6 +9,7 @@
 #include "stewart/config/stack_config.h"
 #include "stewart/estimator/ekf.h"
 #include "stewart/force_command_t.hpp"
+#include "stewart/node/exit_code.h"
 #include "stewart/node/health_reporter.h"
 #include "stewart/node/lcm_receiver.h"
 #include "stewart/sensor_t.hpp"
@@ -21,7 +22,7 @@ class EstimatorNode {
   EstimatorNode(const StackConfig& config, lcm::LCM* lcm, bool perfect_state);
 
   /// Handles messages until a stop signal; returns the exit status.
-  int Run();
+  ExitCode Run();
 
   void OnSensor(const lcm::ReceiveBuffer* rbuf, const std::string& channel, const sensor_t* msg);
   void OnCommand(const lcm::ReceiveBuffer* rbuf, const std::string& channel,

@@ -1,7 +1,7 @@
 // Benchmarks of the model terms that sit on every process's hot path.
 #include <benchmark/benchmark.h>
 
-#include "stewart/config/stack_config.h"
+#include "stewart/config/config_loader.h"
 #include "stewart/model/dynamics.h"
 #include "stewart/model/kinematics.h"
 

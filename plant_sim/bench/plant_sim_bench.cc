@@ -6,7 +6,7 @@
 
 #include <cmath>
 
-#include "stewart/config/stack_config.h"
+#include "stewart/config/config_loader.h"
 #include "stewart/model/kinematics.h"
 #include "stewart/plant_sim/plant.h"
 #include "stewart/plant_sim/sensor_model.h"

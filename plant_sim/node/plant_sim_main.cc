@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "plant_sim_node.h"
+#include "stewart/config/config_loader.h"
 #include "stewart/node/node_options.h"
 #include "stewart/node/stop_signal.h"
 

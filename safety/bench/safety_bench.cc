@@ -4,7 +4,7 @@
 #include <random>
 #include <vector>
 
-#include "stewart/config/stack_config.h"
+#include "stewart/config/config_loader.h"
 #include "stewart/safety/clp_reference_qp.h"
 #include "stewart/safety/safety_filter.h"
 #ifdef STEWART_HAVE_ALGLIB

@@ -136,6 +136,6 @@ void SafetyNode::Publish(const state_t& state, int64_t sample_utime, const Vecto
   (void)state;
 }
 
-int SafetyNode::Run() { return RunNodeLoop("safety", lcm_, &receiver_, &health_, 50); }
+ExitCode SafetyNode::Run() { return RunNodeLoop("safety", lcm_, &receiver_, &health_, 50); }
 
 }  // namespace stewart

@@ -7,6 +7,7 @@
 
 #include "stewart/config/stack_config.h"
 #include "stewart/force_command_t.hpp"
+#include "stewart/node/exit_code.h"
 #include "stewart/node/health_reporter.h"
 #include "stewart/node/lcm_receiver.h"
 #include "stewart/safety/safety_filter.h"
@@ -20,7 +21,7 @@ class SafetyNode {
   SafetyNode(const StackConfig& config, lcm::LCM* lcm, safety::ReferenceQpSolver* reference);
 
   /// Handles LCM traffic until a stop signal. Returns the exit status.
-  int Run();
+  ExitCode Run();
 
   void OnState(const lcm::ReceiveBuffer*, const std::string&, const state_t* msg);
   void OnNominal(const lcm::ReceiveBuffer*, const std::string&, const force_command_t* msg);

@@ -7,7 +7,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "stewart/config/stack_config.h"
+#include "stewart/config/config_loader.h"
 #include "stewart/safety/clp_reference_qp.h"
 #include "stewart/safety/safety_filter.h"
 

@@ -8,8 +8,9 @@
 
 #include <string>
 
-#include "closed_loop.h"
-#include "stewart/config/stack_config.h"
+#include "stewart/config/scenario_loader.h"
+#include "stewart/stack/closed_loop.h"
+#include "stewart/config/config_loader.h"
 #include "stewart/controller/scenario.h"
 
 namespace stewart {

@@ -8,7 +8,7 @@
 #include <functional>
 #include <limits>
 
-#include "stewart/config/stack_config.h"
+#include "stewart/config/config_loader.h"
 
 namespace stewart {
 namespace {

@@ -4,7 +4,7 @@
 
 #include <gtest/gtest.h>
 
-#include "stewart/config/stack_config.h"
+#include "stewart/config/config_loader.h"
 
 namespace stewart {
 namespace {

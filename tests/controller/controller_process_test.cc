@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "stewart/config/stack_config.h"
+#include "stewart/config/config_loader.h"
 #include "stewart/force_command_t.hpp"
 #include "stewart/health_t.hpp"
 #include "stewart/node/lcm_handle.h"

@@ -1,12 +1,13 @@
 // The controller state machine: workspace rejection, invalid states, time
 // from utime, scenario following.
+#include "stewart/config/scenario_loader.h"
 #include "stewart/controller/controller.h"
 
 #include <gtest/gtest.h>
 
 #include <limits>
 
-#include "stewart/config/stack_config.h"
+#include "stewart/config/config_loader.h"
 
 namespace stewart {
 namespace {

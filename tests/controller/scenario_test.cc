@@ -1,12 +1,13 @@
 // Scenario files: the shipped ones say what their comments say; bad files
 // give errors naming the key.
+#include "stewart/config/scenario_loader.h"
 #include "stewart/controller/scenario.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-#include "stewart/config/stack_config.h"
+#include "stewart/config/config_loader.h"
 
 namespace stewart {
 namespace {

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "scenario_truth.h"
+#include "stewart/config/config_loader.h"
 #include "stewart/force_command_t.hpp"
 #include "stewart/health_t.hpp"
 #include "stewart/node/lcm_handle.h"

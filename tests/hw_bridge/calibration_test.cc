@@ -1,3 +1,4 @@
+#include "stewart/config/sections.h"
 #include "stewart/hw_bridge/calibration.h"
 
 #include <gtest/gtest.h>

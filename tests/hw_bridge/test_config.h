@@ -1,5 +1,5 @@
 #pragma once
-#include "stewart/config/stack_config.h"
+#include "stewart/config/config_loader.h"
 
 namespace stewart::hw::test {
 

@@ -1,5 +1,6 @@
 #include "test_states.h"
 
+#include "stewart/config/config_loader.h"
 #include "stewart/model/kinematics.h"
 
 namespace stewart::test {

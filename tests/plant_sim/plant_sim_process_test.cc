@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "plant_test_util.h"
+#include "stewart/config/config_loader.h"
 #include "stewart/force_command_t.hpp"
 #include "stewart/health_t.hpp"
 #include "stewart/model/kinematics.h"

@@ -19,7 +19,8 @@
 #include <string>
 #include <vector>
 
-#include "stewart/config/stack_config.h"
+#include "stewart/config/scenario_loader.h"
+#include "stewart/config/config_loader.h"
 #include "stewart/controller/controller.h"
 #include "stewart/force_command_t.hpp"
 #include "stewart/safety/diagnostics_lcm.h"

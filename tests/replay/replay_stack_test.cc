@@ -28,7 +28,7 @@
 #include <string>
 #include <vector>
 
-#include "stewart/config/stack_config.h"
+#include "stewart/config/config_loader.h"
 
 namespace stewart {
 namespace {

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "stewart/config/config_loader.h"
 #include "stewart/model/kinematics.h"
 
 namespace stewart::safety::test {

@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "stewart/config/stack_config.h"
+#include "stewart/config/config_loader.h"
 #include "stewart/model/dynamics.h"
 #include "stewart/safety/clp_reference_qp.h"
 #include "stewart/safety/diagnostics_lcm.h"

@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "stewart/config/stack_config.h"
+#include "stewart/config/config_loader.h"
 #include "stewart/force_command_t.hpp"
 #include "stewart/model/dynamics.h"
 #include "stewart/node/eigen_msg.h"

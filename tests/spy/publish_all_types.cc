@@ -7,7 +7,7 @@
 #include <cstdlib>
 #include <string>
 
-#include "stewart/config/stack_config.h"
+#include "stewart/config/config_loader.h"
 #include "stewart/force_command_t.hpp"
 #include "stewart/health_t.hpp"
 #include "stewart/node/lcm_handle.h"

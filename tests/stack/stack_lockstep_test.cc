@@ -33,7 +33,7 @@
 #include <string>
 #include <vector>
 
-#include "stewart/config/stack_config.h"
+#include "stewart/config/config_loader.h"
 #include "stewart/state_t.hpp"
 
 namespace stewart {

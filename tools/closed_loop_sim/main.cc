@@ -12,8 +12,9 @@
 #include <memory>
 #include <optional>
 
-#include "closed_loop.h"
-#include "stewart/config/stack_config.h"
+#include "stewart/config/scenario_loader.h"
+#include "stewart/stack/closed_loop.h"
+#include "stewart/config/config_loader.h"
 #include "stewart/controller/scenario.h"
 
 int main(int argc, char** argv) {

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "model_json.h"
-#include "stewart/config/stack_config.h"
+#include "stewart/config/config_loader.h"
 
 int main(int argc, char** argv) {
   CLI::App app{

@@ -22,9 +22,10 @@
 #include <optional>
 #include <string>
 
-#include "replay.h"
-#include "replay_output.h"
-#include "stewart/config/stack_config.h"
+#include "stewart/config/scenario_loader.h"
+#include "stewart/stack/replay.h"
+#include "stewart/stack/replay_output.h"
+#include "stewart/config/config_loader.h"
 #include "stewart/controller/scenario.h"
 #include "stewart/safety/clp_reference_qp.h"
 #ifdef STEWART_HAVE_ALGLIB

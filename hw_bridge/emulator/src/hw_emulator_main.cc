@@ -14,7 +14,7 @@
 #include <ctime>
 #include <memory>
 
-#include "stewart/config/stack_config.h"
+#include "stewart/config/config_loader.h"
 #include "stewart/hw_bridge/transport.h"
 #include "stewart/hw_emulator/device_emulator.h"
 #include "stewart/hw_emulator/plant_backend.h"

@@ -10,19 +10,16 @@
 #include <string_view>
 #include <vector>
 
+#include "stewart/common/check.h"
+#include "stewart/common/enum_table.h"
 #include "stewart/model/types.h"
 
 namespace stewart {
 
-class ConfigError : public std::runtime_error {
+/// Bad configuration: the InputError of a YAML file, naming the full key.
+class ConfigError : public InputError {
  public:
   ConfigError(const std::string& key, const std::string& reason);
-  const std::string& key() const { return key_; }
-  const std::string& reason() const { return reason_; }
-
- private:
-  std::string key_;
-  std::string reason_;
 };
 
 class ConfigNode {
@@ -47,6 +44,11 @@ class ConfigNode {
   std::string String(std::string_view key) const;
   /// A string that must be one of `allowed`.
   std::string Choice(std::string_view key, const std::vector<std::string>& allowed) const;
+  /// A string that must be one of the table's names: its value.
+  template <typename Enum, std::size_t N>
+  Enum EnumValue(std::string_view key, const EnumTable<Enum, N>& table) const {
+    return *table.Find(Choice(key, table.NameList()));
+  }
   Vector3d Vec3(std::string_view key) const;
   Vector6d Vec6(std::string_view key) const;
   std::array<double, 6> Array6(std::string_view key) const;

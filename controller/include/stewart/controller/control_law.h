@@ -8,7 +8,7 @@
 // solved by the model's InverseDynamics (no second copy of the dynamics);
 // F_friction = LegViscousFriction(gains.leg_friction_nspm, H^T qd) is the
 // legs' own viscous friction, cancelled when the config says so.
-#include "stewart/config/controller_config.h"
+#include "stewart/controller/controller_config.h"
 #include "stewart/controller/setpoint.h"
 #include "stewart/model/dynamics.h"
 #include "stewart/model/platform_params.h"

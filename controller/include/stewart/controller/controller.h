@@ -4,7 +4,7 @@
 #include <cstdint>
 #include <optional>
 
-#include "stewart/config/controller_config.h"
+#include "stewart/controller/controller_config.h"
 #include "stewart/controller/control_law.h"
 #include "stewart/controller/scenario.h"
 #include "stewart/model/dynamics.h"

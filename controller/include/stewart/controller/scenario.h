@@ -19,7 +19,6 @@
 #include <string>
 #include <vector>
 
-#include "stewart/config/config_node.h"
 #include "stewart/controller/setpoint.h"
 #include "stewart/model/platform_params.h"
 
@@ -42,6 +41,9 @@ struct ScenarioSegment {
   double period_s = 1.0;
 };
 
+/// The setpoint of one segment at t (s from the scenario's start).
+Setpoint EvaluateSegment(const ScenarioSegment& segment, double t_s);
+
 class Scenario {
  public:
   Scenario(std::string name, double duration_s, std::vector<ScenarioSegment> segments);
@@ -59,15 +61,6 @@ class Scenario {
   double duration_s_;
   std::vector<ScenarioSegment> segments_;
 };
-
-/// Parses scenario YAML. Throws ConfigError naming the key ("segments[2].q_des")
-/// and the reason; `source` is put in front of the key to name the file.
-Scenario ParseScenario(const std::string& yaml_text, const std::string& source = "");
-Scenario LoadScenario(const std::string& path);
-
-/// "paper" -> <source tree>/config/scenarios/paper.yaml; anything with a '/'
-/// or ending in .yaml is taken as a path.
-std::string ResolveScenarioPath(const std::string& name_or_path);
 
 /// First time (sampled every `step_s` over [0, duration_s]) at which the
 /// scenario leaves the workspace (PoseInWorkspace), if any.

@@ -6,7 +6,7 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "stewart/config/hw_bridge_config.h"
+#include "stewart/hw_bridge/hw_bridge_config.h"
 #include "stewart/hw_bridge/calibration.h"
 #include "stewart/hw_bridge/drive_map.h"
 #include "stewart/hw_bridge/link_stats.h"

@@ -4,7 +4,7 @@
 #include <array>
 #include <cstdint>
 
-#include "stewart/config/hw_bridge_config.h"
+#include "stewart/hw_bridge/hw_bridge_config.h"
 #include "stewart/model/types.h"
 
 namespace stewart::hw {

@@ -2,7 +2,7 @@
 // The P-16P linear actuator as the simulator sees it (docs/simulation.md,
 // "Actuators"). Every quantity is per leg, along the leg axis, positive
 // extending; lengths joint to joint (m), speeds dL/dt (m/s), forces (N).
-#include "stewart/config/platform_config.h"
+#include "stewart/model/actuator_params.h"
 #include "stewart/model/types.h"
 
 namespace stewart {

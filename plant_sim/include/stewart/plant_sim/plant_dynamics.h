@@ -10,7 +10,7 @@
 //              integrates only q and qd (docs/simulation.md, "Integrator").
 #include <Eigen/Core>
 
-#include "stewart/config/platform_config.h"
+#include "stewart/model/actuator_params.h"
 #include "stewart/model/dynamics.h"
 #include "stewart/model/platform_params.h"
 

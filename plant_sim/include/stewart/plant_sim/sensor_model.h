@@ -4,8 +4,8 @@
 // generator drawn in a fixed order, so a seed gives one exact sequence.
 #include <random>
 
-#include "stewart/config/platform_config.h"
-#include "stewart/config/sensor_config.h"
+#include "stewart/model/actuator_params.h"
+#include "stewart/model/sensor_params.h"
 #include "stewart/model/types.h"
 
 namespace stewart {

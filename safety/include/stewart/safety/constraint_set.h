@@ -10,7 +10,7 @@
 #include <array>
 #include <string>
 
-#include "stewart/config/safety_config.h"
+#include "stewart/safety/safety_config.h"
 #include "stewart/model/platform_params.h"
 #include "stewart/model/types.h"
 

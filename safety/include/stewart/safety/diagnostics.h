@@ -4,7 +4,7 @@
 #include <array>
 #include <cstdint>
 
-#include "stewart/config/safety_config.h"
+#include "stewart/safety/safety_config.h"
 #include "stewart/safety/barriers.h"
 #include "stewart/safety/two_constraint_qp.h"
 

@@ -12,8 +12,8 @@
 //   SafetyFilter filter(config.platform, config.safety, config.actuators);
 //   SafetyDiagnostics diag;
 //   Vector6d f_safe = filter.Step(q, qd, f_des, &diag);
-#include "stewart/config/platform_config.h"
-#include "stewart/config/safety_config.h"
+#include "stewart/model/actuator_params.h"
+#include "stewart/safety/safety_config.h"
 #include "stewart/model/dynamics.h"
 #include "stewart/safety/constraint_set.h"
 #include "stewart/safety/diagnostics.h"

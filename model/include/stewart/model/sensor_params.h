@@ -1,5 +1,6 @@
 #pragma once
-#include "stewart/config/config_node.h"
+// The sensors as simulated and as expected (config section `sensors`).
+#include "stewart/model/types.h"
 
 namespace stewart {
 
@@ -18,7 +19,6 @@ struct SensorConfig {
   unsigned seed = 0;
 };
 
-SensorConfig ParseSensorConfig(const ConfigNode& sensors);
 
 /// Leg-length step of the potentiometer ADC (m): codes 0 .. 2^bits - 1 span
 /// the stroke, so stroke / (2^bits - 1); 0 when leg_adc_bits = 0 (no

@@ -1,7 +1,7 @@
 #pragma once
 #include <string>
 
-#include "stewart/config/config_node.h"
+#include "stewart/model/types.h"
 
 namespace stewart {
 
@@ -40,6 +40,5 @@ struct HwBridgeConfig {
   Vector6d drive_sign = Vector6d::Ones();  ///< +1 or -1 per leg
 };
 
-HwBridgeConfig ParseHwBridgeConfig(const ConfigNode& hw_bridge);
 
 }  // namespace stewart

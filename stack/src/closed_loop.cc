@@ -1,4 +1,4 @@
-#include "closed_loop.h"
+#include "stewart/stack/closed_loop.h"
 
 #include <cmath>
 #include <cstdio>

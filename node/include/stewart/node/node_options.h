@@ -17,8 +17,12 @@ struct NodeOptions {
 
 void AddNodeOptions(CLI::App* app, NodeOptions* options);
 
-/// Loads the config and applies the overrides. On a bad config logs one clear
-/// line naming the key and exits with status 2.
+/// Sets the log level, loads the config and applies the overrides. Throws
+/// ConfigError naming the key.
+StackConfig LoadNodeConfig(const NodeOptions& options);
+
+/// LoadNodeConfig for tools that are not nodes: on a bad config logs one clear
+/// line naming the key and exits with ExitCode::kBadInput.
 StackConfig LoadNodeConfigOrExit(const NodeOptions& options);
 
 /// When the process was started with a real-time scheduling policy

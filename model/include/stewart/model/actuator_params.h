@@ -1,7 +1,5 @@
 #pragma once
-// platform, legs and actuators sections: the physical model.
-#include "stewart/config/config_node.h"
-#include "stewart/model/platform_params.h"
+// The legs' actuators as the model sees them (config section `actuators`).
 
 namespace stewart {
 
@@ -14,10 +12,5 @@ struct ActuatorConfig {
   double endstop_stiffness_npm = 0.0;
   double endstop_damping_nspm = 0.0;
 };
-
-/// Parses `platform`, `legs` and the geometric part of `actuators` into the
-/// model's parameters.
-PlatformParams ParsePlatformParams(const ConfigNode& root);
-ActuatorConfig ParseActuatorConfig(const ConfigNode& actuators);
 
 }  // namespace stewart

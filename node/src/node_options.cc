@@ -1,4 +1,7 @@
+#include "stewart/config/config_loader.h"
 #include "stewart/node/node_options.h"
+
+#include "stewart/node/exit_code.h"
 
 #include <sched.h>
 #include <spdlog/spdlog.h>
@@ -20,16 +23,20 @@ void AddNodeOptions(CLI::App* app, NodeOptions* options) {
       ->capture_default_str();
 }
 
-StackConfig LoadNodeConfigOrExit(const NodeOptions& options) {
+StackConfig LoadNodeConfig(const NodeOptions& options) {
   spdlog::set_level(spdlog::level::from_str(options.log_level));
+  StackConfig config = LoadStackConfig(options.config_path);
+  if (!options.lcm_url.empty()) config.lcm.url = options.lcm_url;
+  if (!options.channel_suffix.empty()) SetChannelSuffix(&config.lcm, options.channel_suffix);
+  return config;
+}
+
+StackConfig LoadNodeConfigOrExit(const NodeOptions& options) {
   try {
-    StackConfig config = LoadStackConfig(options.config_path);
-    if (!options.lcm_url.empty()) config.lcm.url = options.lcm_url;
-    if (!options.channel_suffix.empty()) SetChannelSuffix(&config.lcm, options.channel_suffix);
-    return config;
+    return LoadNodeConfig(options);
   } catch (const ConfigError& e) {
     spdlog::error("{} (file: {})", e.what(), options.config_path);
-    std::exit(2);
+    std::exit(ToInt(ExitCode::kBadInput));
   }
 }
 

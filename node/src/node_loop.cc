@@ -11,7 +11,7 @@ void ReportReceiverCounters(const LcmReceiver& receiver, HealthReporter* health)
   health->SetCounter("rx_decode_fail", receiver.counters().decode_failures);
 }
 
-int RunNodeLoop(const std::string& name, lcm::LCM* lcm, LcmReceiver* receiver,
+ExitCode RunNodeLoop(const std::string& name, lcm::LCM* lcm, LcmReceiver* receiver,
                 HealthReporter* health, int poll_ms, const std::function<bool()>& done) {
   health->MaybePublish(lcm, true);
   while (!StopRequested()) {
@@ -19,7 +19,7 @@ int RunNodeLoop(const std::string& name, lcm::LCM* lcm, LcmReceiver* receiver,
       spdlog::error("{}: LCM receive failed", name);
       health->SetState(health_t::STATE_FAULT);
       health->MaybePublish(lcm, true);
-      return 1;
+      return ExitCode::kFault;
     }
     ReportReceiverCounters(*receiver, health);
     health->MaybePublish(lcm);
@@ -27,7 +27,7 @@ int RunNodeLoop(const std::string& name, lcm::LCM* lcm, LcmReceiver* receiver,
   }
   health->SetState(health_t::STATE_STOPPED);
   health->MaybePublish(lcm, true);
-  return 0;
+  return ExitCode::kOk;
 }
 
 }  // namespace stewart

@@ -3,6 +3,7 @@
 #include <lcm/lcm-cpp.hpp>
 #include <string>
 
+#include "stewart/node/exit_code.h"
 #include "stewart/node/health_reporter.h"
 #include "stewart/node/lcm_receiver.h"
 
@@ -11,14 +12,14 @@ namespace stewart {
 /// The event loop of a message-driven node: handles the receiver's traffic
 /// and beats the heartbeat (published through `lcm`) until a stop signal or
 /// until `done()` returns true. A
-/// receive error reports FAULT and returns 1; a clean stop reports STOPPED and
-/// returns 0. A stop signal interrupting the wait (EINTR) is a clean stop.
+/// receive error reports FAULT and returns kFault; a clean stop reports
+/// STOPPED and returns kOk. A stop signal interrupting the wait (EINTR) is a clean stop.
 /// Puts the receiver's counts of unusable input into the heartbeat:
 /// rx_bad (datagrams that are not valid LCM) and rx_decode_fail (messages
 /// on a subscribed channel that did not decode as its type).
 void ReportReceiverCounters(const LcmReceiver& receiver, HealthReporter* health);
 
-int RunNodeLoop(const std::string& name, lcm::LCM* lcm, LcmReceiver* receiver,
+ExitCode RunNodeLoop(const std::string& name, lcm::LCM* lcm, LcmReceiver* receiver,
                 HealthReporter* health, int poll_ms, const std::function<bool()>& done = {});
 
 }  // namespace stewart

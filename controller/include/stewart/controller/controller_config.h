@@ -1,5 +1,5 @@
 #pragma once
-#include "stewart/config/config_node.h"
+#include "stewart/model/types.h"
 
 namespace stewart {
 
@@ -14,6 +14,5 @@ struct ControllerConfig {
   double leg_friction_nspm = 0.0;  ///< N per m/s of leg speed
 };
 
-ControllerConfig ParseControllerConfig(const ConfigNode& controller);
 
 }  // namespace stewart

@@ -3,7 +3,7 @@
 #include <string>
 #include <vector>
 
-#include "stewart/config/config_node.h"
+#include "stewart/common/enum_table.h"
 
 namespace stewart {
 
@@ -32,7 +32,18 @@ struct LegStrokeLimitConfig {
 /// kUncomposed: every barrier its own condition, no LSE (docs/safety.md,
 /// "The un-composed QP"), to measure what the composition costs.
 enum class SafetyVariant { kClosedForm, kPaperRule, kQpReference, kUncomposed };
+inline constexpr EnumTable<SafetyVariant, 4> kSafetyVariantNames{{{
+    {SafetyVariant::kClosedForm, "closed_form"},
+    {SafetyVariant::kPaperRule, "paper"},
+    {SafetyVariant::kQpReference, "qp"},
+    {SafetyVariant::kUncomposed, "uncomposed"},
+}}};
+
 enum class SafetyFallback { kHold, kZero };
+inline constexpr EnumTable<SafetyFallback, 2> kSafetyFallbackNames{{{
+    {SafetyFallback::kHold, "hold"},
+    {SafetyFallback::kZero, "zero"},
+}}};
 
 /// How the filter measures the size of its correction F* - F_des
 /// (docs/safety.md, "Correction metric"):
@@ -40,6 +51,10 @@ enum class SafetyFallback { kHold, kZero };
 ///   kAcceleration: (qdd - qdd_des)^T M (qdd - qdd_des)
 ///                  = (F - F_des)^T H^T M^-1 H (F - F_des)   (Gauss's least constraint)
 enum class CorrectionMetric { kForce, kAcceleration };
+inline constexpr EnumTable<CorrectionMetric, 2> kCorrectionMetricNames{{{
+    {CorrectionMetric::kForce, "force"},
+    {CorrectionMetric::kAcceleration, "acceleration"},
+}}};
 
 /// `safety`: the CBF filter's constraints and parameters.
 struct SafetyConfig {
@@ -70,10 +85,18 @@ struct SafetyConfig {
   double leg_friction_nspm = 0.0;
 };
 
-SafetyConfig ParseSafetyConfig(const ConfigNode& safety);
-std::string ToString(SafetyVariant variant);
-SafetyVariant ParseSafetyVariant(const std::string& name);  ///< throws std::invalid_argument
-std::string ToString(CorrectionMetric metric);
-CorrectionMetric ParseCorrectionMetric(const std::string& name);  ///< throws std::invalid_argument
+inline std::string ToString(SafetyVariant variant) {
+  return std::string(kSafetyVariantNames.Name(variant));
+}
+/// Throws InputError (an std::invalid_argument) listing the names.
+inline SafetyVariant ParseSafetyVariant(const std::string& name) {
+  return kSafetyVariantNames.Parse(name, "safety variant");
+}
+inline std::string ToString(CorrectionMetric metric) {
+  return std::string(kCorrectionMetricNames.Name(metric));
+}
+inline CorrectionMetric ParseCorrectionMetric(const std::string& name) {
+  return kCorrectionMetricNames.Parse(name, "correction metric");
+}
 
 }  // namespace stewart

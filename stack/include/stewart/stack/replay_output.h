@@ -6,7 +6,7 @@
 #include <ostream>
 #include <string>
 
-#include "replay.h"
+#include "stewart/stack/replay.h"
 
 namespace stewart::replay {
 

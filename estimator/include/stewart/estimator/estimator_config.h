@@ -1,5 +1,4 @@
 #pragma once
-#include "stewart/config/config_node.h"
 
 namespace stewart {
 
@@ -41,6 +40,5 @@ struct EstimatorConfig {
   bool perfect_state = false;        ///< pass ground truth through; testing only
 };
 
-EstimatorConfig ParseEstimatorConfig(const ConfigNode& estimator);
 
 }  // namespace stewart

@@ -1,7 +1,7 @@
 #pragma once
 #include <string>
 
-#include "stewart/config/config_node.h"
+#include "stewart/model/types.h"
 
 namespace stewart {
 
@@ -18,6 +18,5 @@ struct PlantSimConfig {
   Vector6d initial_velocity = Vector6d::Zero();
 };
 
-PlantSimConfig ParsePlantSimConfig(const ConfigNode& plant_sim);
 
 }  // namespace stewart

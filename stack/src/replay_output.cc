@@ -1,4 +1,4 @@
-#include "replay_output.h"
+#include "stewart/stack/replay_output.h"
 
 #include <spdlog/fmt/fmt.h>
 

@@ -1,4 +1,4 @@
-#include "replay.h"
+#include "stewart/stack/replay.h"
 
 #include <algorithm>
 #include <cmath>

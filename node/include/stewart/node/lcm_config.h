@@ -1,0 +1,54 @@
+#pragma once
+// The stack's LCM wiring (config sections `lcm` and `rates`): the URL and
+// every channel name. Header-only, shared by the nodes, replay and the loader.
+#include <string>
+
+namespace stewart {
+
+/// Full channel names: lcm.channel_prefix + lcm.channels.<name> + suffix.
+struct ChannelNames {
+  std::string sensors;
+  std::string state_estimate;
+  std::string state_truth;
+  std::string setpoint;
+  std::string command_nominal;
+  std::string command_safe;
+  std::string safety_diagnostics;
+  std::string health;
+};
+
+/// `lcm` and `rates`.
+struct LcmConfig {
+  std::string url;
+  std::string channel_prefix;
+  std::string channel_suffix;
+  ChannelNames channels;
+  double health_rate_hz = 2.0;
+};
+
+/// Every channel: its config key under lcm.channels and its field.
+struct ChannelField {
+  const char* key;
+  std::string ChannelNames::*member;
+};
+inline constexpr ChannelField kChannelFields[] = {
+    {"sensors", &ChannelNames::sensors},
+    {"state_estimate", &ChannelNames::state_estimate},
+    {"state_truth", &ChannelNames::state_truth},
+    {"setpoint", &ChannelNames::setpoint},
+    {"command_nominal", &ChannelNames::command_nominal},
+    {"command_safe", &ChannelNames::command_safe},
+    {"safety_diagnostics", &ChannelNames::safety_diagnostics},
+    {"health", &ChannelNames::health},
+};
+
+/// Applies a new suffix to every channel (two stacks on one network).
+inline void SetChannelSuffix(LcmConfig* lcm, const std::string& suffix) {
+  for (const ChannelField& field : kChannelFields) {
+    std::string& name = lcm->channels.*field.member;
+    name = name.substr(0, name.size() - lcm->channel_suffix.size()) + suffix;
+  }
+  lcm->channel_suffix = suffix;
+}
+
+}  // namespace stewart
