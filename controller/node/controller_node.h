@@ -1,12 +1,13 @@
 #pragma once
-// Wires stewart::Controller to LCM: state estimate in, nominal force command
-// (and, when following a scenario, the active setpoint) out.
+// The controller process on LCM: state estimate in, nominal force command
+// (and, when following a scenario, the active setpoint) out. Every decision
+// is ControllerProcess's; this class subscribes, converts and publishes.
 #include <lcm/lcm-cpp.hpp>
 #include <memory>
 #include <optional>
 
 #include "stewart/config/stack_config.h"
-#include "stewart/controller/controller.h"
+#include "stewart/controller/controller_process.h"
 #include "stewart/force_command_t.hpp"
 #include "stewart/node/exit_code.h"
 #include "stewart/node/health_reporter.h"
@@ -32,11 +33,9 @@ class ControllerNode {
   StackConfig config_;
   lcm::LCM* lcm_;
   LcmReceiver receiver_;
-  Controller controller_;
   HealthReporter health_;
+  ControllerProcess process_;
   bool exit_at_end_;
-  int64_t command_seq_ = 0;
-  int64_t setpoint_seq_ = 0;
   force_command_t command_{};
   setpoint_t setpoint_echo_{};
 };

@@ -1,13 +1,14 @@
 #pragma once
-// The `estimator` process: one EKF update per sensor_t on channels.sensors,
-// the safe force command (channels.command_safe) as the process model's
-// input, state_t on channels.state_estimate. Optional perfect-state mode
-// republishes channels.state_truth instead (testing only).
+// The estimator process on LCM: sensor_t on channels.sensors and the safe
+// command (channels.command_safe, the process model's input) in, state_t on
+// channels.state_estimate out; in perfect-state mode channels.state_truth is
+// republished instead (testing only). Every decision is EstimatorProcess's;
+// this class subscribes, converts and publishes.
 #include <lcm/lcm-cpp.hpp>
 #include <string>
 
 #include "stewart/config/stack_config.h"
-#include "stewart/estimator/ekf.h"
+#include "stewart/estimator/estimator_process.h"
 #include "stewart/force_command_t.hpp"
 #include "stewart/node/exit_code.h"
 #include "stewart/node/health_reporter.h"
@@ -21,7 +22,7 @@ class EstimatorNode {
  public:
   EstimatorNode(const StackConfig& config, lcm::LCM* lcm, bool perfect_state);
 
-  /// Handles messages until a stop signal; returns the exit status.
+  /// Handles messages until a stop signal.
   ExitCode Run();
 
   void OnSensor(const lcm::ReceiveBuffer* rbuf, const std::string& channel, const sensor_t* msg);
@@ -32,15 +33,14 @@ class EstimatorNode {
   HealthReporter& health() { return health_; }
 
  private:
-  void Publish(const state_t& msg);
+  void Publish(const StateSample& state);
 
   StackConfig config_;
   lcm::LCM* lcm_;
   LcmReceiver receiver_;
-  bool perfect_state_;
-  Ekf ekf_;
   HealthReporter health_;
-  int64_t seq_ = 0;
+  EstimatorProcess process_;
+  state_t state_msg_{};
 };
 
 }  // namespace stewart

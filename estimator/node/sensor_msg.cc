@@ -16,19 +16,4 @@ SensorSample SampleFromMessage(const sensor_t& msg) {
   return s;
 }
 
-state_t StateFromEstimate(const Estimate& estimate, int64_t seq) {
-  state_t msg{};
-  msg.utime = estimate.utime;
-  msg.seq = seq;
-  msg.sample_utime = estimate.utime;
-  ToArray(estimate.q, msg.q);
-  ToArray(estimate.qd, msg.qd);
-  ToArray(estimate.q_std, msg.q_std);
-  ToArray(estimate.qd_std, msg.qd_std);
-  msg.status = estimate.initializing ? int32_t{state_t::STATUS_INITIALIZING}
-                                     : int32_t{state_t::STATUS_VALID};
-  if (estimate.diverged) msg.status |= state_t::STATUS_DIVERGED;
-  return msg;
-}
-
 }  // namespace stewart

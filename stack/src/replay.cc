@@ -9,10 +9,12 @@
 #include <unordered_set>
 
 #include "sensor_msg.h"
-#include "stewart/controller/controller.h"
-#include "stewart/estimator/ekf.h"
+#include "stewart/common/health_counters.h"
+#include "stewart/controller/controller_process.h"
+#include "stewart/estimator/estimator_process.h"
 #include "stewart/node/eigen_msg.h"
-#include "stewart/safety/safety_filter.h"
+#include "stewart/node/signal_messages.h"
+#include "stewart/safety/safety_process.h"
 #include "stewart/safety_diagnostics_t.hpp"
 
 namespace stewart::replay {
@@ -42,11 +44,6 @@ const typename Map::mapped_type* Find(const Map& map, int64_t key) {
 
 bool IsFallback(int32_t flags) {
   return (flags & (force_command_t::FLAG_FALLBACK | force_command_t::FLAG_STALE_INPUT)) != 0;
-}
-
-// As the safety node and the controller judge a state estimate.
-bool StateUsable(const state_t& s) {
-  return (s.status & state_t::STATUS_VALID) != 0 && (s.status & state_t::STATUS_DIVERGED) == 0;
 }
 
 SafetyVariant FromLcmVariant(int8_t v) {
@@ -219,7 +216,12 @@ TimeStats ComputeTimeStats(std::vector<int64_t> ns) {
 SafetyReplayResult ReplaySafety(const StackConfig& config, const RecordedLog& log,
                                 safety::ReferenceQpSolver* reference) {
   SafetyReplayResult r;
-  safety::SafetyFilter filter(config.platform, config.safety, config.actuators, reference);
+  // The process's own class: its Filter and Fallback make the replayed
+  // commands, so they are built exactly as the live node built them.
+  HealthCounters counters("safety replay");
+  safety::SafetyProcess process(config.platform, config.safety, config.actuators, reference,
+                                &counters);
+  const safety::SafetyFilter& filter = process.filter();
   r.variant = filter.variant();
   if (r.variant == SafetyVariant::kQpReference && reference != nullptr) {
     r.qp_solver = reference->name();
@@ -251,8 +253,7 @@ SafetyReplayResult ReplaySafety(const StackConfig& config, const RecordedLog& lo
   }
 
   // Every recorded nominal command with the estimate of the same
-  // sample_utime, as SafetyNode::OnNominal pairs them.
-  safety::SafetyDiagnostics d;
+  // sample_utime, as SafetyProcess::OnNominal pairs them.
   std::vector<int64_t> replayed_ns, recorded_ns;
   std::unordered_map<int64_t, size_t> step_of;
   r.steps.reserve(log.nominal.size());
@@ -264,14 +265,13 @@ SafetyReplayResult ReplaySafety(const StackConfig& config, const RecordedLog& lo
       continue;
     }
     const state_t& state = log.estimates[static_cast<size_t>(*state_index)];
-    const Vector6d f =
-        filter.Step(FromArray(state.q), FromArray(state.qd), FromArray(nominal.force_n), &d);
+    const safety::SafetyOutput out = process.Filter(FromMessage(state), FromMessage(nominal));
     SafetyStep step;
     step.sample_utime = nominal.sample_utime;
-    step.f_replayed = ToStdArray(f);
-    step.replayed_flags = d.flags;
-    step.replayed_case = static_cast<int8_t>(d.filter_case);
-    step.replayed_ns = d.compute_ns;
+    step.f_replayed = ToStdArray(out.command.force_n);
+    step.replayed_flags = out.command.flags;
+    step.replayed_case = static_cast<int8_t>(out.diagnostics->filter_case);
+    step.replayed_ns = out.diagnostics->compute_ns;
     ++r.replayed_cases[static_cast<size_t>(step.replayed_case)];
     const int* safe_index = Find(safe_of, nominal.sample_utime);
     if (safe_index == nullptr) {
@@ -303,7 +303,7 @@ SafetyReplayResult ReplaySafety(const StackConfig& config, const RecordedLog& lo
   r.recorded_ns = ComputeTimeStats(std::move(recorded_ns));
 
   // Every recorded fallback, replayed along the path the node took
-  // (SafetyNode::PublishFallback, or the filter's own last resort).
+  // (SafetyProcess::Fallback, or the filter's own last resort).
   for (const force_command_t& recorded : log.safe) {
     if (!IsFallback(recorded.flags)) continue;
     ++r.fallback_commands;
@@ -316,18 +316,19 @@ SafetyReplayResult ReplaySafety(const StackConfig& config, const RecordedLog& lo
     std::array<double, 6> f{};
     int32_t flags = 0;
     int32_t node_reason = 0;
-    if (recorded.flags & force_command_t::FLAG_STALE_INPUT) {
+    if (recorded.flags & kCommandStaleInput) {
       ++r.fallback_stale_input;
-      node_reason = force_command_t::FLAG_STALE_INPUT;
-    } else if (!StateUsable(state)) {
+      node_reason = kCommandStaleInput;
+    } else if (!StateUsable(state.status)) {
       ++r.fallback_invalid_state;
-      node_reason = force_command_t::FLAG_INVALID_INPUT;
+      node_reason = kCommandInvalidInput;
     } else {
       ++r.fallback_by_filter;
     }
     if (node_reason != 0) {
-      f = ToStdArray(filter.SafeStopCommand(FromArray(state.q), FromArray(state.qd), &d));
-      flags = d.flags | node_reason;
+      const safety::SafetyOutput out = process.Fallback(FromMessage(state), node_reason);
+      f = ToStdArray(out.command.force_n);
+      flags = out.command.flags;
     } else {
       const size_t* step_index = Find(step_of, recorded.sample_utime);
       if (step_index == nullptr) {
@@ -372,37 +373,40 @@ ControllerReplayResult ReplayController(const StackConfig& config, const Scenari
                                         const RecordedLog& log) {
   ControllerReplayResult r;
   r.scenario = scenario.name();
-  Controller controller(config.platform, config.controller, config.home_pose, scenario);
+  HealthCounters counters("controller replay");
+  ControllerProcess process(config.platform, config.controller, config.home_pose, scenario,
+                            &counters);
   const auto recorded_of = IndexBySample(log.nominal);
   std::unordered_set<int64_t> replayed_samples;
   const std::optional<int64_t> origin = ControllerTimeOrigin(log, &r.time_origin_inferred);
   r.time_origin_utime = origin.value_or(-1);
   bool started = false;
-  // ControllerNode::OnState, per recorded estimate in log order.
-  for (const state_t& state : log.estimates) {
+  // The process's OnState, per recorded estimate in log order.
+  for (const state_t& state_msg : log.estimates) {
     ++r.states;
-    if (!StateUsable(state)) {
+    const StateSample state = FromMessage(state_msg);
+    ControllerProcessOutput out;
+    if (!started && origin && *origin < state.utime && StateUsable(state)) {
+      // The first state the live controller stepped on is not in the log:
+      // start the clock there (this step's output is not compared).
+      StateSample at_origin = state;
+      at_origin.utime = *origin;
+      process.OnState(at_origin, &out);
+    }
+    const ControllerVerdict verdict = process.OnState(state, &out);
+    if (verdict == ControllerVerdict::kStateNotUsable) {
       ++r.invalid_states;
       continue;
     }
-    ControllerOutput out;
-    if (!started && origin && *origin < state.utime) {
-      // The first state the live controller stepped on is not in the log:
-      // start the clock there (this step's output is not compared).
-      controller.Step(*origin, FromArray(state.q), FromArray(state.qd), &out);
-    }
     started = true;
-    const StepStatus status =
-        controller.Step(state.utime, FromArray(state.q), FromArray(state.qd), &out);
-    if (status != StepStatus::kOk) {
+    if (verdict == ControllerVerdict::kStepRejected) {
       ++r.step_rejected;
       continue;
     }
     ++r.replayed;
     replayed_samples.insert(state.sample_utime);
     force_command_t command{};
-    ToArray(out.force_n, command.force_n);
-    command.flags = out.setpoint_rejected ? force_command_t::FLAG_SETPOINT_REJECTED : 0;
+    ToMessage(out.command, &command);
     const int* index = Find(recorded_of, state.sample_utime);
     if (index == nullptr) {
       ++r.without_recorded_command;
@@ -455,12 +459,15 @@ EstimatorReplayResult ReplayEstimator(const StackConfig& config, const RecordedL
   }
   const auto recorded_of = IndexBySample(log.estimates);
   std::unordered_set<int64_t> replayed_samples;
-  int64_t seq = 0;
-  auto compare = [&](const state_t& replayed) {
+  HealthCounters counters("estimator replay");
+  EstimatorProcess process(config.platform, config.actuators, config.sensors, config.estimator,
+                           config.home_pose, &counters);
+  auto compare = [&](const StateSample& sample) {
+    state_t replayed{};
+    ToMessage(sample, &replayed);
     // EstimatorNode::Publish drops non-finite estimates.
     if (!EstimateFinite(replayed)) return;
     ++r.replayed;
-    ++seq;
     replayed_samples.insert(replayed.sample_utime);
     const int* index = Find(recorded_of, replayed.sample_utime);
     if (index == nullptr) {
@@ -497,31 +504,25 @@ EstimatorReplayResult ReplayEstimator(const StackConfig& config, const RecordedL
   };
 
   if (r.perfect_state) {
-    // EstimatorNode::OnTruth: the ground truth, republished.
+    // EstimatorProcess::OnTruth: the ground truth, republished.
     for (const state_t& truth : log.truth) {
-      if (!AllFinite(truth.q) || !AllFinite(truth.qd)) continue;
-      state_t state = truth;
-      state.seq = seq;
-      state.status = state_t::STATUS_VALID | state_t::STATUS_PERFECT_STATE;
-      compare(state);
+      StateSample state;
+      if (process.OnTruth(FromMessage(truth), &state)) compare(state);
     }
   } else {
-    // EstimatorNode::OnCommand / OnSensor, in the order the log received them.
-    Ekf ekf(config.platform, config.actuators, config.sensors, config.estimator, config.home_pose);
+    // EstimatorProcess::OnCommand / OnSensor, in the order the log received them.
     for (const auto& [channel, index] : log.order) {
       if (channel == Channel::kCommandSafe) {
         const force_command_t& command = log.safe[static_cast<size_t>(index)];
         ++r.commands;
-        if (!AllFinite(command.force_n)) {
-          ++r.rejected_commands;
-          continue;
-        }
-        ekf.SetForceCommand(command.sample_utime, FromArray(command.force_n));
+        if (!AllFinite(command.force_n)) ++r.rejected_commands;
+        process.OnCommand(FromMessage(command));
       } else if (channel == Channel::kSensors) {
         ++r.sensor_samples;
-        const UpdateResult result =
-            ekf.Update(SampleFromMessage(log.sensors[static_cast<size_t>(index)]));
-        if (result.has_estimate) compare(StateFromEstimate(ekf.estimate(), seq));
+        StateSample state;
+        if (process.OnSensor(SampleFromMessage(log.sensors[static_cast<size_t>(index)]), &state)) {
+          compare(state);
+        }
       }
     }
   }

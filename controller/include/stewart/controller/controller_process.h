@@ -1,0 +1,54 @@
+#pragma once
+// The controller process's decisions, without LCM: which state estimates it
+// acts on, what it rejects and counts, the nominal command it publishes and
+// the setpoint it echoes. The node (controller/node) converts messages and
+// publishes; replay drives the same class over a recorded log.
+#include <cstdint>
+#include <optional>
+
+#include "stewart/common/health_counters.h"
+#include "stewart/common/signals.h"
+#include "stewart/controller/controller.h"
+
+namespace stewart {
+
+/// The setpoint a scenario-following controller tracked for one state.
+struct SetpointEcho {
+  int64_t utime = 0;
+  int64_t seq = 0;
+  int64_t sample_utime = 0;
+  Setpoint setpoint;
+};
+
+/// What one state estimate produced.
+struct ControllerProcessOutput {
+  ForceCommand command;  ///< the nominal command F_des
+  bool has_setpoint_echo = false;
+  SetpointEcho setpoint_echo;  ///< when following a scenario
+};
+
+/// Why a state estimate produced no command (kPublished when it did).
+enum class ControllerVerdict { kPublished, kStateNotUsable, kStepRejected };
+
+class ControllerProcess {
+ public:
+  /// `counters` must outlive this object.
+  ControllerProcess(const PlatformParams& platform, const ControllerConfig& gains,
+                    const Vector6d& home_pose, std::optional<Scenario> scenario,
+                    HealthCounters* counters);
+
+  /// A state estimate arrived: kPublished fills `out`.
+  ControllerVerdict OnState(const StateSample& state, ControllerProcessOutput* out);
+  /// A live setpoint arrived (only without a scenario).
+  void OnSetpoint(const Setpoint& setpoint);
+
+  const Controller& controller() const { return controller_; }
+
+ private:
+  Controller controller_;
+  HealthCounters* counters_;
+  int64_t command_seq_ = 0;
+  int64_t setpoint_seq_ = 0;
+};
+
+}  // namespace stewart

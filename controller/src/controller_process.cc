@@ -1,0 +1,56 @@
+#include "stewart/controller/controller_process.h"
+
+#include <string>
+#include <utility>
+
+#include "stewart/common/check.h"
+
+namespace stewart {
+
+ControllerProcess::ControllerProcess(const PlatformParams& platform, const ControllerConfig& gains,
+                                     const Vector6d& home_pose, std::optional<Scenario> scenario,
+                                     HealthCounters* counters)
+    : controller_(platform, gains, home_pose, std::move(scenario)), counters_(counters) {
+  STEWART_CHECK(counters_ != nullptr, "ControllerProcess needs its counters");
+}
+
+void ControllerProcess::OnSetpoint(const Setpoint& setpoint) {
+  counters_->CountIn();
+  const SetpointStatus status = controller_.OfferSetpoint(setpoint);
+  if (status != SetpointStatus::kAccepted) counters_->Reject(ToString(status));
+}
+
+ControllerVerdict ControllerProcess::OnState(const StateSample& state,
+                                             ControllerProcessOutput* out) {
+  counters_->CountIn();
+  if (!StateUsable(state)) {
+    counters_->Reject("state_not_valid", "status " + std::to_string(state.status));
+    return ControllerVerdict::kStateNotUsable;
+  }
+  ControllerOutput step;
+  const StepStatus status = controller_.Step(state.utime, state.q, state.qd, &step);
+  if (status != StepStatus::kOk) {
+    counters_->Reject(ToString(status));
+    return ControllerVerdict::kStepRejected;
+  }
+  if (step.scenario_rejection) counters_->Reject(ToString(*step.scenario_rejection));
+
+  out->command.utime = state.sample_utime;
+  out->command.seq = command_seq_++;
+  out->command.sample_utime = state.sample_utime;
+  out->command.force_n = step.force_n;
+  out->command.flags = step.setpoint_rejected ? kCommandSetpointRejected : 0;
+  counters_->CountOut();
+  out->has_setpoint_echo = controller_.following_scenario();
+  if (out->has_setpoint_echo) {
+    out->setpoint_echo.utime = state.sample_utime;
+    out->setpoint_echo.seq = setpoint_seq_++;
+    out->setpoint_echo.sample_utime = state.sample_utime;
+    out->setpoint_echo.setpoint = step.setpoint;
+  }
+  counters_->SetStackTime(state.utime, state.sample_utime);
+  counters_->SetState(step.setpoint_rejected ? health_state::kDegraded : health_state::kOk);
+  return ControllerVerdict::kPublished;
+}
+
+}  // namespace stewart

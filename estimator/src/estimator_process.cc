@@ -1,0 +1,90 @@
+#include "stewart/estimator/estimator_process.h"
+
+#include <spdlog/spdlog.h>
+
+#include "stewart/common/check.h"
+
+namespace stewart {
+
+StateSample StateFromEstimate(const Estimate& estimate, int64_t seq) {
+  StateSample s;
+  s.utime = estimate.utime;
+  s.seq = seq;
+  s.sample_utime = estimate.utime;
+  s.q = estimate.q;
+  s.qd = estimate.qd;
+  s.q_std = estimate.q_std;
+  s.qd_std = estimate.qd_std;
+  s.status = estimate.initializing ? kStateInitializing : kStateValid;
+  if (estimate.diverged) s.status |= kStateDiverged;
+  return s;
+}
+
+EstimatorProcess::EstimatorProcess(const PlatformParams& platform,
+                                   const ActuatorConfig& actuators, const SensorConfig& sensors,
+                                   const EstimatorConfig& estimator, const Vector6d& home_pose,
+                                   HealthCounters* counters)
+    : ekf_(platform, actuators, sensors, estimator, home_pose), counters_(counters) {
+  STEWART_CHECK(counters_ != nullptr, "EstimatorProcess needs its counters");
+}
+
+void EstimatorProcess::OnCommand(const ForceCommand& command) {
+  counters_->CountIn();
+  if (!command.force_n.allFinite()) {
+    counters_->Reject("command_non_finite");
+    return;
+  }
+  ekf_.SetForceCommand(command.sample_utime, command.force_n);
+}
+
+bool EstimatorProcess::OnSensor(const SensorSample& sample, StateSample* out) {
+  counters_->CountIn();
+  const UpdateResult result = ekf_.Update(sample);
+  for (uint32_t bit = 1; bit <= kEventLast; bit <<= 1) {
+    if (!(result.events & bit)) continue;
+    const auto event = static_cast<EkfEvent>(bit);
+    if (IsRejection(event)) {
+      counters_->Reject(EkfEventName(event));
+    } else {
+      counters_->Count(EkfEventName(event));
+    }
+  }
+  if (result.Has(kEventDiverged)) {
+    spdlog::warn("estimator: divergence detected at utime {}: restarted from the legs",
+                 sample.utime);
+  }
+  if (!result.has_estimate) return false;
+  const Estimate& estimate = ekf_.estimate();
+  counters_->SetState(estimate.diverged ? health_state::kDegraded : health_state::kOk);
+  counters_->SetStackTime(sample.utime, sample.utime);
+  return Emit(StateFromEstimate(estimate, seq_), out);
+}
+
+bool EstimatorProcess::OnTruth(const StateSample& truth, StateSample* out) {
+  counters_->CountIn();
+  if (!truth.q.allFinite() || !truth.qd.allFinite()) {
+    counters_->Reject("truth_non_finite");
+    return false;
+  }
+  StateSample state = truth;
+  state.seq = seq_;
+  state.status = kStateValid | kStatePerfectState;
+  counters_->SetState(health_state::kDegraded);  // perfect state is never a real estimate
+  counters_->SetError("perfect_state mode");
+  counters_->SetStackTime(truth.utime, truth.sample_utime);
+  return Emit(state, out);
+}
+
+bool EstimatorProcess::Emit(const StateSample& state, StateSample* out) {
+  if (!state.q.allFinite() || !state.qd.allFinite() || !state.q_std.allFinite() ||
+      !state.qd_std.allFinite()) {
+    counters_->Reject("estimate_non_finite");
+    return false;
+  }
+  *out = state;
+  ++seq_;
+  counters_->CountOut();
+  return true;
+}
+
+}  // namespace stewart

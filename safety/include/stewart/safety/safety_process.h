@@ -1,0 +1,82 @@
+#pragma once
+// The safety process's decisions, without LCM: which state estimate a nominal
+// command is filtered against, when a command waits for its state, when the
+// controller is stale, which fallback goes out and why, what is rejected,
+// and the safe command that results. The node (safety/node) only converts
+// messages and publishes what this returns; replay and the in-process
+// closed loop call the same class, so they decide as the process does.
+//
+// All timing comes from message utimes (stack time), never the wall clock.
+#include <array>
+#include <cstdint>
+
+#include "stewart/common/health_counters.h"
+#include "stewart/common/signals.h"
+#include "stewart/safety/safety_filter.h"
+
+namespace stewart::safety {
+
+/// One safe command to publish, with the diagnostics of the step that made it.
+struct SafetyOutput {
+  ForceCommand command;  ///< utime = sample_utime of the state it answers
+  /// The node's reason on top of the filter's flags: kCommandStaleInput
+  /// (watchdog or stale nominal), kCommandInvalidInput (state not usable),
+  /// or 0 for a filtered nominal command.
+  int32_t fallback_reason = 0;
+  const SafetyDiagnostics* diagnostics = nullptr;  ///< valid until the next call
+};
+
+class SafetyProcess {
+ public:
+  /// `counters` receives rejections and the process counters
+  /// (fallback_commands, active_steps, infeasible, nominal_before_state) and
+  /// must outlive this object; `reference` as for SafetyFilter.
+  SafetyProcess(const PlatformParams& platform, const SafetyConfig& safety,
+                const ActuatorConfig& actuators, ReferenceQpSolver* reference,
+                HealthCounters* counters);
+
+  /// A state estimate arrived. Returns true when `out` holds a command to
+  /// publish: the pending nominal command for this state, filtered; or a
+  /// fallback (state not usable, or no recent nominal command: the watchdog).
+  bool OnState(const StateSample& state, SafetyOutput* out);
+
+  /// A nominal command arrived. Returns true when `out` holds a command to
+  /// publish: the filtered command, or a fallback for a stale one.
+  bool OnNominal(const ForceCommand& nominal, SafetyOutput* out);
+
+  /// The filter step for a nominal command against its state (what OnState
+  /// and OnNominal publish when they filter).
+  SafetyOutput Filter(const StateSample& state, const ForceCommand& nominal);
+  /// The safe stop at `state`, flagged with `reason` (kCommandStaleInput or
+  /// kCommandInvalidInput).
+  SafetyOutput Fallback(const StateSample& state, int32_t reason);
+
+  const SafetyFilter& filter() const { return filter_; }
+  int64_t stale_age_us() const { return stale_age_us_; }
+
+ private:
+  const StateSample* FindState(int64_t sample_utime) const;
+  /// Publishing bookkeeping shared by every output.
+  SafetyOutput Emit(const Vector6d& force_n, int64_t sample_utime, int32_t fallback_reason);
+
+  SafetyFilter filter_;
+  HealthCounters* counters_;
+  const int64_t stale_age_us_;
+
+  // The states the next nominal commands can refer to (a command derives
+  // from one state estimate, matched by sample_utime).
+  static constexpr int kStateHistory = 64;
+  std::array<StateSample, kStateHistory> states_{};
+  int states_count_ = 0;
+  int states_next_ = 0;
+  int64_t newest_state_utime_ = -1;
+  int64_t newest_nominal_sample_utime_ = -1;
+  int64_t last_published_sample_utime_ = -1;
+  // A nominal command that arrived before its state (see OnNominal).
+  ForceCommand pending_nominal_{};
+  bool has_pending_nominal_ = false;
+  int64_t seq_ = 0;
+  SafetyDiagnostics diagnostics_{};
+};
+
+}  // namespace stewart::safety

@@ -1,0 +1,139 @@
+#include "stewart/safety/safety_process.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace stewart::safety {
+namespace {
+
+bool StateFinite(const StateSample& s) { return s.q.allFinite() && s.qd.allFinite(); }
+
+}  // namespace
+
+SafetyProcess::SafetyProcess(const PlatformParams& platform, const SafetyConfig& safety,
+                             const ActuatorConfig& actuators, ReferenceQpSolver* reference,
+                             HealthCounters* counters)
+    : filter_(platform, safety, actuators, reference),
+      counters_(counters),
+      stale_age_us_(static_cast<int64_t>(safety.stale_age_s * 1e6)) {
+  STEWART_CHECK(counters_ != nullptr, "SafetyProcess needs its counters");
+  counters_->SetCounter("fallback_commands", 0);
+  counters_->SetCounter("active_steps", 0);
+  counters_->SetCounter("infeasible", 0);
+  counters_->SetState(health_state::kOk);
+}
+
+const StateSample* SafetyProcess::FindState(int64_t sample_utime) const {
+  for (int k = 0; k < states_count_; ++k) {
+    const int index = (states_next_ - 1 - k + kStateHistory) % kStateHistory;
+    if (states_[static_cast<size_t>(index)].sample_utime == sample_utime) {
+      return &states_[static_cast<size_t>(index)];
+    }
+  }
+  return nullptr;
+}
+
+bool SafetyProcess::OnState(const StateSample& state, SafetyOutput* out) {
+  counters_->CountIn();
+  if (!StateFinite(state)) {
+    counters_->Reject("nonfinite_state");
+    return false;
+  }
+  if (state.utime <= newest_state_utime_) {
+    counters_->Reject("state_time_not_increasing");
+    return false;
+  }
+  states_[static_cast<size_t>(states_next_)] = state;
+  states_next_ = (states_next_ + 1) % kStateHistory;
+  states_count_ = std::min(states_count_ + 1, kStateHistory);
+  newest_state_utime_ = state.utime;
+  counters_->SetStackTime(state.utime, state.sample_utime);
+
+  // The watchdog: no nominal command derived from a recent enough state
+  // means the controller is gone or late. Judged against state time, so a
+  // replayed log behaves as it did live.
+  const bool pending_for_this =
+      has_pending_nominal_ && pending_nominal_.sample_utime == state.sample_utime;
+  has_pending_nominal_ = has_pending_nominal_ && !pending_for_this &&
+                         pending_nominal_.sample_utime > state.sample_utime;
+  if (!StateUsable(state)) {
+    if (state.sample_utime <= last_published_sample_utime_) return false;
+    *out = Fallback(state, kCommandInvalidInput);
+    return true;
+  }
+  if (pending_for_this) {
+    *out = Filter(state, pending_nominal_);
+    return true;
+  }
+  if (state.utime - newest_nominal_sample_utime_ > stale_age_us_) {
+    if (state.sample_utime <= last_published_sample_utime_) return false;
+    *out = Fallback(state, kCommandStaleInput);
+    return true;
+  }
+  return false;
+}
+
+bool SafetyProcess::OnNominal(const ForceCommand& nominal, SafetyOutput* out) {
+  counters_->CountIn();
+  // A command that arrives, even one answered already by a fallback, shows
+  // the controller is alive.
+  newest_nominal_sample_utime_ = std::max(newest_nominal_sample_utime_, nominal.sample_utime);
+  if (nominal.sample_utime <= last_published_sample_utime_) {
+    counters_->Reject("nominal_already_answered");  // a fallback went out for it
+    return false;
+  }
+  const StateSample* state = FindState(nominal.sample_utime);
+  if (state == nullptr) {
+    if (nominal.sample_utime > newest_state_utime_) {
+      // Multicast from two senders is not ordered: on a loaded machine the
+      // controller's answer can overtake the estimate it answers. Held until
+      // that state arrives (OnState), never filtered against another state.
+      pending_nominal_ = nominal;
+      has_pending_nominal_ = true;
+      counters_->Count("nominal_before_state");
+      return false;
+    }
+    counters_->Reject("nominal_without_state");
+    return false;
+  }
+  if (newest_state_utime_ - nominal.sample_utime > stale_age_us_) {
+    counters_->Reject("stale_nominal");
+    if (state->sample_utime <= last_published_sample_utime_) return false;
+    *out = Fallback(*state, kCommandStaleInput);
+    return true;
+  }
+  *out = Filter(*state, nominal);
+  return true;
+}
+
+SafetyOutput SafetyProcess::Filter(const StateSample& state, const ForceCommand& nominal) {
+  const Vector6d f_safe = filter_.Step(state.q, state.qd, nominal.force_n, &diagnostics_);
+  if (diagnostics_.flags & kFlagInvalidInput) counters_->Reject("invalid_nominal");
+  return Emit(f_safe, nominal.sample_utime, 0);
+}
+
+SafetyOutput SafetyProcess::Fallback(const StateSample& state, int32_t reason) {
+  const Vector6d f = filter_.SafeStopCommand(state.q, state.qd, &diagnostics_);
+  counters_->Count("fallback_commands");
+  return Emit(f, state.sample_utime, reason);
+}
+
+SafetyOutput SafetyProcess::Emit(const Vector6d& force_n, int64_t sample_utime,
+                                 int32_t fallback_reason) {
+  last_published_sample_utime_ = sample_utime;
+  SafetyOutput out;
+  out.command.utime = sample_utime;
+  out.command.seq = seq_++;
+  out.command.sample_utime = sample_utime;
+  out.command.force_n = force_n;
+  out.command.flags = diagnostics_.flags | fallback_reason;
+  out.fallback_reason = fallback_reason;
+  out.diagnostics = &diagnostics_;
+  counters_->CountOut();
+  // For monitors that follow the run from the heartbeat alone.
+  if (diagnostics_.flags & kFlagFilterActive) counters_->Count("active_steps");
+  if (diagnostics_.infeasible) counters_->Count("infeasible");
+  return out;
+}
+
+}  // namespace stewart::safety
