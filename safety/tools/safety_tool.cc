@@ -1,7 +1,7 @@
 // safety_tool: reads {"q":[6],"qd":[6],"f_des":[6]} JSON lines on stdin and
 // prints F* and the filter's diagnostics as one JSON line each: how a user
 // finds out why the filter acted.
-//   safety_tool [--config FILE] [--variant closed_form|paper|qp|uncomposed] [--force-limits]
+//   safety_tool [--config FILE] [--variant V] [--force-limits]
 #include <CLI/CLI.hpp>
 #include <iostream>
 #include <nlohmann/json.hpp>
@@ -38,7 +38,7 @@ int main(int argc, char** argv) {
   bool force_limits = false;
   app.add_option("--config", config_path, "platform YAML");
   app.add_option("--variant", variant,
-                 "closed_form | paper | qp | uncomposed (default: from config)");
+                 stewart::kSafetyVariantNames.Names() + " (default: from config)");
   app.add_flag("--force-limits", force_limits, "also enforce |F_i| <= actuators.force_limit_n");
   CLI11_PARSE(app, argc, argv);
   try {

@@ -60,7 +60,7 @@ ClosedLoopSummary RunClosedLoop(const StackConfig& config, const Scenario& scena
   SensorModel sensor_model(sensors, config.actuators, config.platform.gravity_mps2);
   Ekf ekf(config.platform, config.actuators, sensors, config.estimator, config.home_pose);
   Controller controller(config.platform, config.controller, config.home_pose, scenario);
-  safety::SafetyFilter filter(config.platform, config.safety, config.actuators);
+  safety::SafetyFilter filter(config.platform, config.safety, config.actuators, options.reference);
 
   const std::int64_t period_us = std::llround(1e6 / sensors.rate_hz);
   const long ticks = std::lround(options.duration_s * 1e6 / static_cast<double>(period_us));

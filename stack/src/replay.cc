@@ -14,6 +14,7 @@
 #include "stewart/estimator/estimator_process.h"
 #include "stewart/node/eigen_msg.h"
 #include "stewart/node/signal_messages.h"
+#include "stewart/safety/diagnostics_lcm.h"
 #include "stewart/safety/safety_process.h"
 #include "stewart/safety_diagnostics_t.hpp"
 
@@ -46,18 +47,6 @@ bool IsFallback(int32_t flags) {
   return (flags & (force_command_t::FLAG_FALLBACK | force_command_t::FLAG_STALE_INPUT)) != 0;
 }
 
-SafetyVariant FromLcmVariant(int8_t v) {
-  switch (v) {
-    case safety_diagnostics_t::VARIANT_PAPER_RULE:
-      return SafetyVariant::kPaperRule;
-    case safety_diagnostics_t::VARIANT_QP_REFERENCE:
-      return SafetyVariant::kQpReference;
-    case safety_diagnostics_t::VARIANT_UNCOMPOSED:
-      return SafetyVariant::kUncomposed;
-    default:
-      return SafetyVariant::kClosedForm;
-  }
-}
 
 std::array<double, 6> ToStdArray(const Vector6d& v) {
   std::array<double, 6> a{};
@@ -241,7 +230,7 @@ SafetyReplayResult ReplaySafety(const StackConfig& config, const RecordedLog& lo
     const auto most =
         std::max_element(variants.begin(), variants.end(),
                          [](const auto& a, const auto& b) { return a.second < b.second; });
-    r.recorded_variant = FromLcmVariant(most->first);
+    r.recorded_variant = safety::FromLcmVariant(most->first);
     r.recorded_force_limits = 2 * limited > static_cast<long>(log.diagnostics.size());
   }
 

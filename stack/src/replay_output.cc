@@ -10,8 +10,6 @@ namespace {
 
 using nlohmann::ordered_json;
 
-constexpr const char* kCaseNames[6] = {"none", "position",   "velocity",
-                                       "both", "infeasible", "fallback"};
 
 const char* KindName(SafetyStepKind kind) {
   switch (kind) {
@@ -137,7 +135,9 @@ ordered_json ToJson(const ReplayReport& report) {
     js["fallback"] = fallback;
     js["compute_ns"] = {{"replayed", ToJson(s.replayed_ns)}, {"recorded", ToJson(s.recorded_ns)}};
     ordered_json cases;
-    for (size_t i = 0; i < 6; ++i) cases[kCaseNames[i]] = s.replayed_cases[i];
+    for (size_t i = 0; i < s.replayed_cases.size(); ++i) {
+      cases[std::string(safety::kFilterCaseNames.entries[i].second)] = s.replayed_cases[i];
+    }
     js["replayed_cases"] = cases;
     j["safety"] = js;
   }
@@ -237,7 +237,9 @@ std::string FormatSummary(const ReplayReport& report) {
                      Us(s.recorded_ns), s.replayed_ns.count);
     o += "  replayed cases       ";
     for (size_t i = 0; i < 6; ++i) {
-      if (s.replayed_cases[i]) o += fmt::format(" {} {}", kCaseNames[i], s.replayed_cases[i]);
+      if (s.replayed_cases[i]) {
+        o += fmt::format(" {} {}", safety::kFilterCaseNames.entries[i].second, s.replayed_cases[i]);
+      }
     }
     o += "\n";
   }

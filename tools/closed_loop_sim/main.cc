@@ -13,6 +13,7 @@
 #include <optional>
 
 #include "stewart/config/scenario_loader.h"
+#include "stewart/safety/clp_reference_qp.h"
 #include "stewart/stack/closed_loop.h"
 #include "stewart/config/config_loader.h"
 #include "stewart/controller/scenario.h"
@@ -33,7 +34,7 @@ int main(int argc, char** argv) {
   app.add_option("--seed", options.seed, "sensor noise seed");
   app.add_option("--k-velocity", k_velocity, "override safety.k_velocity");
   app.add_option("--k-position", k_position, "override safety.k_position");
-  app.add_option("--variant", variant, "closed_form | paper | uncomposed");
+  app.add_option("--variant", variant, kSafetyVariantNames.Names() + " (qp: Clp reference)");
   app.add_flag("--no-filter", options.no_filter, "pass F_des through (to see what it prevents)");
   app.add_option("--csv", csv_path, "write t, q, qd, q_est, qd_est, F_des, F*, case per tick");
   CLI11_PARSE(app, argc, argv);
@@ -47,6 +48,8 @@ int main(int argc, char** argv) {
     options.duration_s = duration_s.value_or(scenario.duration_s());
     std::unique_ptr<std::ofstream> csv;
     if (!csv_path.empty()) csv = std::make_unique<std::ofstream>(csv_path);
+    safety::ClpReferenceQp reference;
+    options.reference = &reference;
     const ClosedLoopSummary s = RunClosedLoop(config, scenario, options, csv.get());
     std::printf("%s", FormatSummary(config, s).c_str());
     return s.completed ? 0 : 1;

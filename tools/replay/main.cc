@@ -2,7 +2,7 @@
 // and the estimator) offline on the inputs recorded in a run folder of
 // tools/launch.sh, and compares with what the live processes published.
 //
-//   stewart_replay runs/<run> [--variant closed_form|paper|qp] [--qp-solver clp|alglib]
+//   stewart_replay runs/<run> [--variant V] [--qp-solver clp|alglib]
 //       [--k-velocity K] [--k-position K] [--controller] [--estimator]
 //       [--json FILE] [--csv FILE] [--expect-identical]
 //
@@ -236,7 +236,8 @@ int main(int argc, char** argv) {
   app.add_option("--scenario", o.scenario_path,
                  "scenario for --controller (default: <run>/scenario.yaml)");
   app.add_option("--variant", o.variant,
-                 "closed_form | paper | qp (default: the run's, run.yaml, else the config's)");
+                 stewart::kSafetyVariantNames.Names() +
+                     " (default: the run's, run.yaml, else the config's)");
   app.add_option("--qp-solver", o.qp_solver, "reference QP solver for variant qp: clp | alglib");
   app.add_option("--k-velocity", o.k_velocity, "override safety.k_velocity");
   app.add_option("--k-position", o.k_position, "override safety.k_position");

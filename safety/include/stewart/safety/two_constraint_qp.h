@@ -6,7 +6,10 @@
 // F* = F_des + mu_p g_p + mu_v g_v, mu >= 0. The exact KKT case analysis
 // tries the cases in order and returns the first whose KKT conditions hold;
 // the QP is strictly convex so, when feasible, exactly that one is optimal.
+#include <array>
 #include <cstdint>
+
+#include "stewart/common/enum_table.h"
 
 #include "stewart/model/types.h"
 
@@ -21,6 +24,17 @@ enum class FilterCase : std::int8_t {
   kInfeasible = 4,  ///< the QP has no solution (reported by the solver)
   kFallback = 5,    ///< invalid input: the safe stop was applied
 };
+/// Every case by its value: kFilterCaseNames.entries[i].first == FilterCase(i).
+inline constexpr EnumTable<FilterCase, 6> kFilterCaseNames{{{
+    {FilterCase::kNone, "none"},
+    {FilterCase::kPosition, "position"},
+    {FilterCase::kVelocity, "velocity"},
+    {FilterCase::kBoth, "both"},
+    {FilterCase::kInfeasible, "infeasible"},
+    {FilterCase::kFallback, "fallback"},
+}}};
+/// Counts per case, indexed by the case's value.
+using FilterCaseCounts = std::array<long, kFilterCaseNames.size()>;
 
 /// The two affine conditions. An absent group (no constraint configured) is
 /// never active.

@@ -9,6 +9,8 @@
 #include "stewart/config/stack_config.h"
 #include "stewart/controller/scenario.h"
 #include "stewart/model/types.h"
+#include "stewart/safety/reference_qp.h"
+#include "stewart/safety/two_constraint_qp.h"
 
 namespace stewart {
 
@@ -16,6 +18,8 @@ struct ClosedLoopOptions {
   double duration_s = 40.0;
   bool perfect_state = false;  ///< ground truth to controller and filter instead of the EKF
   bool no_filter = false;      ///< F* = F_des (to measure what the filter prevents)
+  /// The reference solver for variant qp (must outlive the run); unused otherwise.
+  safety::ReferenceQpSolver* reference = nullptr;
   std::uint64_t seed = 1;      ///< sensor noise seed (overrides sensors.seed)
 };
 
@@ -28,7 +32,7 @@ struct ClosedLoopSummary {
   std::string max_limit_excess_name;  ///< which limit, e.g. "xd upper"
   double rms_q_error = 0.0;           ///< estimate vs truth, translations (m)
   double rms_qd_error = 0.0;          ///< estimate vs truth, translational rates (m/s)
-  std::array<long, 6> case_ticks{};   ///< ticks per FilterCase
+  safety::FilterCaseCounts case_ticks{};  ///< ticks per FilterCase
   long infeasible_ticks = 0;
   long saturated_ticks = 0;  ///< ticks where |F*_i| exceeded the actuator force limit
   double max_force_n = 0.0;
@@ -42,7 +46,7 @@ struct ClosedLoopSummary {
   /// Per axis: ticks where that axis' setpoint is inside its position limits
   /// (always, for an axis without limits), and the RMS of q_true - q_des over
   /// them (m, rad): the tracking the filter should not cost.
-  std::array<long, 6> inside_ticks{};
+  std::array<long, kNumAxes> inside_ticks{};
   Vector6d rms_tracking_error_inside = Vector6d::Zero();
   double mean_correction_n() const {
     return filtered_ticks > 0 ? sum_correction_n / static_cast<double>(filtered_ticks) : 0.0;

@@ -21,6 +21,7 @@
 #include "stewart/controller/scenario.h"
 #include "stewart/force_command_t.hpp"
 #include "stewart/safety/reference_qp.h"
+#include "stewart/safety/two_constraint_qp.h"
 #include "stewart/sensor_t.hpp"
 #include "stewart/state_t.hpp"
 
@@ -162,7 +163,7 @@ struct SafetyReplayResult {
 
   TimeStats replayed_ns;  ///< filter time of the replay, over the compared steps
   TimeStats recorded_ns;  ///< the live filter's (safety_diagnostics_t.compute_ns), same steps
-  std::array<long, 6> replayed_cases{};  ///< per CASE_*, over every replayed step
+  safety::FilterCaseCounts replayed_cases{};  ///< per FilterCase, over every replayed step
   std::vector<SafetyStep> steps;         ///< in recorded nominal order
 };
 

@@ -4,25 +4,38 @@
 // Reusing one message object across steps keeps the string and array
 // capacities, so steady-state filling does not allocate.
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <utility>
 
 #include "stewart/safety/safety_filter.h"
 #include "stewart/safety_diagnostics_t.hpp"
 
 namespace stewart::safety {
 
+/// Every variant and its safety_diagnostics_t::VARIANT_* value, in the order
+/// of kSafetyVariantNames.
+inline constexpr std::array<std::pair<SafetyVariant, std::int8_t>, kSafetyVariantNames.size()>
+    kLcmVariants{{
+        {SafetyVariant::kClosedForm, safety_diagnostics_t::VARIANT_CLOSED_FORM},
+        {SafetyVariant::kPaperRule, safety_diagnostics_t::VARIANT_PAPER_RULE},
+        {SafetyVariant::kQpReference, safety_diagnostics_t::VARIANT_QP_REFERENCE},
+        {SafetyVariant::kUncomposed, safety_diagnostics_t::VARIANT_UNCOMPOSED},
+    }};
+
 inline std::int8_t ToLcmVariant(SafetyVariant v) {
-  switch (v) {
-    case SafetyVariant::kClosedForm:
-      return safety_diagnostics_t::VARIANT_CLOSED_FORM;
-    case SafetyVariant::kPaperRule:
-      return safety_diagnostics_t::VARIANT_PAPER_RULE;
-    case SafetyVariant::kQpReference:
-      return safety_diagnostics_t::VARIANT_QP_REFERENCE;
-    case SafetyVariant::kUncomposed:
-      return safety_diagnostics_t::VARIANT_UNCOMPOSED;
+  for (const auto& [variant, value] : kLcmVariants) {
+    if (variant == v) return value;
   }
   return safety_diagnostics_t::VARIANT_CLOSED_FORM;
+}
+
+/// The variant of a recorded VARIANT_* value; closed form for an unknown one.
+inline SafetyVariant FromLcmVariant(std::int8_t value) {
+  for (const auto& [variant, v] : kLcmVariants) {
+    if (v == value) return variant;
+  }
+  return SafetyVariant::kClosedForm;
 }
 
 /// Fills everything but utime, seq and sample_utime (the node's job).
