@@ -18,14 +18,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-OdeOptions OdeOptionsFrom(const PlantSimConfig& c) {
-  OdeOptions o;
-  o.method = ParseOdeMethod(c.integrator);
-  o.rel_tol = c.rel_tol;
-  o.abs_tol = c.abs_tol;
-  return o;
-}
-
 int64_t PeriodUs(double rate_hz) {
   const int64_t period_us = std::llround(1e6 / rate_hz);
   if (period_us <= 0) throw std::invalid_argument("sensors.rate_hz is too high (period < 1 us)");

@@ -11,6 +11,8 @@
 #include <memory>
 #include <string>
 
+#include "stewart/plant_sim/plant_sim_config.h"
+
 namespace stewart {
 
 enum class OdeMethod { kArkodeErk, kCvodeBdf, kCvodeAdams };
@@ -38,6 +40,10 @@ struct OdeOptions {
   double abs_tol = 1e-10;
   int erk_order = 5;  ///< kArkodeErk only: ARKODE's default table of this order (2-8)
 };
+
+/// The integrator and tolerances of the `plant_sim` section; throws
+/// std::invalid_argument for an unknown integrator.
+OdeOptions OdeOptionsFrom(const PlantSimConfig& config);
 
 class OdeIntegrator {
  public:
