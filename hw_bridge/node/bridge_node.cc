@@ -40,8 +40,7 @@ BridgeNode::BridgeNode(const StackConfig& config, lcm::LCM* lcm, hw::Transport* 
 }
 
 ExitCode BridgeNode::Run() {
-  std::array<pollfd, 2> fds{pollfd{transport_->fd(), POLLIN, 0},
-                            pollfd{receiver_.fd(), POLLIN, 0}};
+  std::array<pollfd, 2> fds{pollfd{transport_->fd(), POLLIN, 0}, pollfd{receiver_.fd(), POLLIN, 0}};
   while (!StopRequested()) {
     const int ready = poll(fds.data(), fds.size(), 5);
     if (ready > 0 && (fds[0].revents & (POLLIN | POLLERR | POLLHUP)) != 0) ReadDevice();

@@ -171,8 +171,8 @@ bool HwBridge::LinkDown(int64_t host_now_us) const {
 }
 
 LinkHealth HwBridge::Health(int64_t host_now_us, const std::string& link_description) const {
-  const uint16_t device_faults =
-      last_device_status_ & (kStatusLegFault | kStatusImuFault | kStatusWatchdog | kStatusSupplyLow);
+  const uint16_t device_faults = last_device_status_ & (kStatusLegFault | kStatusImuFault |
+                                                        kStatusWatchdog | kStatusSupplyLow);
   if (counters_.sensor_frames == 0) {
     return {LinkState::kStarting, "no sensor frame from the device yet (" + link_description + ")"};
   }
@@ -180,8 +180,8 @@ LinkHealth HwBridge::Health(int64_t host_now_us, const std::string& link_descrip
     return {LinkState::kFault, "device link down: no sensor frame for > link_timeout_s"};
   }
   if (last_reason_ != DriveReason::kCommand) {
-    return {LinkState::kDegraded, std::string("zero drive: ") + ToString(last_reason_) +
-                                      " safe command"};
+    return {LinkState::kDegraded,
+            std::string("zero drive: ") + ToString(last_reason_) + " safe command"};
   }
   if (device_faults != 0) {
     return {LinkState::kDegraded, "device status " + std::to_string(last_device_status_)};

@@ -28,8 +28,7 @@ int main(int argc, char** argv) {
   std::string integrator;
   double rate_hz = 0.0;
   return stewart::NodeMain(
-      argc, argv,
-      {"plant_sim", "plant_sim: the Stewart platform simulated with SUNDIALS, on LCM"},
+      argc, argv, {"plant_sim", "plant_sim: the Stewart platform simulated with SUNDIALS, on LCM"},
       [&](CLI::App& app) {
         app.add_option("--mode", mode, "realtime | lockstep")
             ->check(CLI::IsMember({"realtime", "lockstep"}))

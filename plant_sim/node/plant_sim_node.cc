@@ -26,8 +26,7 @@ int64_t PeriodUs(double rate_hz) {
 
 }  // namespace
 
-PlantSimNode::PlantSimNode(const StackConfig& config, lcm::LCM* lcm,
-                           const PlantSimOptions& options)
+PlantSimNode::PlantSimNode(const StackConfig& config, lcm::LCM* lcm, const PlantSimOptions& options)
     : config_(config),
       options_(options),
       lcm_(lcm),
@@ -135,7 +134,8 @@ void PlantSimNode::HandleCommand(const lcm::ReceiveBuffer*, const std::string&,
   const Vector6d force_n = FromArray(msg->force_n);
   const CommandGate::Decision d = gate_.Check(force_n, msg->sample_utime, msg->seq);
   if (d.timed) {
-    if (const auto latency_us = latency_tracker_.OnCommand(msg->sample_utime, tick_, Clock::now())) {
+    if (const auto latency_us =
+            latency_tracker_.OnCommand(msg->sample_utime, tick_, Clock::now())) {
       latency_.Add(*latency_us);
     }
   }

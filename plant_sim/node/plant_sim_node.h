@@ -8,10 +8,10 @@
 
 #include "stewart/config/stack_config.h"
 #include "stewart/force_command_t.hpp"
+#include "stewart/node/exit_code.h"
 #include "stewart/node/health_reporter.h"
 #include "stewart/node/latency_histogram.h"
 #include "stewart/node/lcm_receiver.h"
-#include "stewart/node/exit_code.h"
 #include "stewart/plant_sim/command_gate.h"
 #include "stewart/plant_sim/command_policy.h"
 #include "stewart/plant_sim/loop_latency_tracker.h"

@@ -193,7 +193,7 @@ TEST(FrameReader, DatagramsDecodeWholeAndStreamsReassemble) {
 
   FrameReader datagrams(true);
   datagrams.Feed(buf.data(), n, buf.size(), on_frame, on_error);
-  datagrams.Feed(buf.data(), n - 1, buf.size(), on_frame, on_error);       // truncated
+  datagrams.Feed(buf.data(), n - 1, buf.size(), on_frame, on_error);           // truncated
   datagrams.Feed(buf.data(), buf.size() + 1, buf.size(), on_frame, on_error);  // too long
   EXPECT_EQ(got, std::vector<uint32_t>{SampleSensorFrame().seq});
   EXPECT_EQ(errors.size(), 2U);

@@ -47,8 +47,7 @@ uint64_t EmulatorPeriodUs(double rate_hz) {
   return period_us;
 }
 
-EmulatorNode::EmulatorNode(const StackConfig& config, lcm::LCM* lcm,
-                           const EmulatorOptions& options)
+EmulatorNode::EmulatorNode(const StackConfig& config, lcm::LCM* lcm, const EmulatorOptions& options)
     : config_(config),
       lcm_(lcm),
       options_(options),

@@ -10,7 +10,8 @@ int main(int argc, char** argv) {
   CLI::Option* lcm_url = nullptr;
   return stewart::NodeMain(
       argc, argv,
-      {"hw_emulator", "hw_emulator: the device side of the wire protocol on plant_sim's plant model",
+      {"hw_emulator",
+       "hw_emulator: the device side of the wire protocol on plant_sim's plant model",
        /*needs_lcm=*/false},
       [&](CLI::App& app) {
         app.add_option("--transport", options.transport, "udp | pty")
@@ -22,7 +23,8 @@ int main(int argc, char** argv) {
                        "udp: address to bind (default hw_bridge.device_host)");
         app.add_option("--device-port", options.device_port,
                        "udp: port to bind (default hw_bridge.device_port)");
-        app.add_option("--host", options.host, "udp: bridge address (default hw_bridge.local_host)");
+        app.add_option("--host", options.host,
+                       "udp: bridge address (default hw_bridge.local_host)");
         app.add_option("--host-port", options.host_port,
                        "udp: bridge port (default hw_bridge.local_port)");
         app.add_option("--rate-hz", options.rate_hz, "sample rate (default sensors.rate_hz)");

@@ -8,9 +8,9 @@
 #include <cstdint>
 #include <string>
 
-#include "stewart/hw_bridge/hw_bridge_config.h"
 #include "stewart/hw_bridge/calibration.h"
 #include "stewart/hw_bridge/drive_map.h"
+#include "stewart/hw_bridge/hw_bridge_config.h"
 #include "stewart/hw_bridge/link_stats.h"
 #include "stewart/hw_bridge/wire_format.h"
 #include "stewart/model/types.h"

@@ -1,10 +1,10 @@
 #pragma once
 // A thin RAII wrapper over the SUNDIALS 6.4 integrators the simulator can
-// use (docs/simulation.md, "Integrator" gives the measured choice):
+// use (docs/simulation.md, "Integrator", says which and why):
 //   kArkodeErk   ARKODE ERKStep, explicit adaptive Runge-Kutta, order 5
 //                (Cash-Karp 6-4-5); a restart (ERKStepReset) keeps the step
 //                size, so a restart at every force change costs one extra
-//                right-hand side and one 1 ms tick is usually one step.
+//                right-hand side and one control tick is usually one step.
 //   kCvodeBdf    CVODE BDF (orders 1-5) with a dense direct linear solver.
 //   kCvodeAdams  CVODE Adams-Moulton (orders 1-12), fixed-point iteration.
 // The system size and the number of root functions are fixed at construction.
