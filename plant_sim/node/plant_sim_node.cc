@@ -10,6 +10,7 @@
 #include "stewart/node/node_loop.h"
 #include "stewart/node/stop_signal.h"
 #include "stewart/plant_sim/lockstep_pacing.h"
+#include "stewart/plant_sim/real_time_pacing.h"
 #include "stewart/sensor_t.hpp"
 #include "stewart/state_t.hpp"
 
@@ -200,20 +201,14 @@ ExitCode PlantSimNode::RunRealTime() {
                                             .count();
   latency_tracker_ = LoopLatencyTracker(utime0_, period_us_);
   tick_accounting_ = TickAccounting(utime0_, period_us_);
-  const auto period = std::chrono::microseconds(period_us_);
   UpdateTickCounters();
-  const Clock::time_point start = Clock::now();
+  const RealTimePacing pacing(period_us_, Clock::now());
   for (tick_ = 0;; ++tick_) {
-    const Clock::time_point deadline = start + tick_ * period;
-    // Commands are taken in while waiting for the tick; the one newest at
-    // the tick acts over the whole following interval (zero-order hold).
-    // Waiting on the socket until the deadline (not sleeping) takes each
-    // command in as it arrives, so its latency is measured when it lands.
+    const Clock::time_point deadline = pacing.Deadline(tick_);
     while (!StopRequested()) {
-      const Clock::duration left = deadline - Clock::now();
-      if (left <= Clock::duration::zero()) break;
-      receiver_.HandleTimeoutUs(std::min<int64_t>(
-          std::chrono::duration_cast<std::chrono::microseconds>(left).count() + 1, 50000));
+      const int64_t wait_us = RealTimePacing::WaitUs(deadline, Clock::now());
+      if (wait_us == 0) break;
+      receiver_.HandleTimeoutUs(wait_us);
     }
     while (receiver_.HandleTimeout(0) > 0) {
     }

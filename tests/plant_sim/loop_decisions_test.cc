@@ -1,7 +1,7 @@
 // The plant_sim process's decisions without sockets: which commands act
 // (CommandGate), the sample-to-command latency (LoopLatencyTracker), whose
 // fault a missed tick is (TickAccounting) and lockstep's resend and timeout
-// (LockstepPacing).
+// (LockstepPacing) and when a real-time tick is due (RealTimePacing).
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -10,6 +10,7 @@
 #include "stewart/plant_sim/command_gate.h"
 #include "stewart/plant_sim/lockstep_pacing.h"
 #include "stewart/plant_sim/loop_latency_tracker.h"
+#include "stewart/plant_sim/real_time_pacing.h"
 #include "stewart/plant_sim/tick_accounting.h"
 
 namespace stewart {
@@ -194,6 +195,17 @@ TEST(LockstepPacing, TickZeroIsNotResentWhenStartupRepublishIsOff) {
   pacing.StartWaiting(1, t0 + milliseconds(6000));
   EXPECT_FALSE(pacing.Poll(t0 + milliseconds(6199)).resend);
   EXPECT_TRUE(pacing.Poll(t0 + milliseconds(6200)).resend);
+}
+
+TEST(RealTimePacing, TicksOnTheGridAndWaitsInBoundedSlices) {
+  const Clock::time_point t0{};
+  const RealTimePacing pacing(1000, t0);
+  EXPECT_EQ(pacing.Deadline(0), t0);
+  EXPECT_EQ(pacing.Deadline(7), t0 + milliseconds(7));
+  EXPECT_EQ(RealTimePacing::WaitUs(t0 + milliseconds(7), t0 + milliseconds(7)), 0);  // due
+  EXPECT_EQ(RealTimePacing::WaitUs(t0 + milliseconds(7), t0 + milliseconds(8)), 0);  // late
+  EXPECT_EQ(RealTimePacing::WaitUs(t0 + milliseconds(7), t0 + microseconds(6600)), 401);
+  EXPECT_EQ(RealTimePacing::WaitUs(t0 + std::chrono::seconds(2), t0), RealTimePacing::kMaxWaitUs);
 }
 
 }  // namespace
