@@ -36,6 +36,10 @@ const char* ToString(CommandVerdict verdict) {
   return "unknown";
 }
 
+bool SendsAtOnce(CommandVerdict verdict) {
+  return verdict == CommandVerdict::kAccepted || verdict == CommandVerdict::kNonFinite;
+}
+
 HwBridge::HwBridge(const HwBridgeConfig& hw, double min_length_m, double stroke_m,
                    double force_limit_n)
     : hw_(hw),
@@ -102,6 +106,13 @@ bool HwBridge::OnSensorFrame(const SensorFrame& frame, int64_t host_rx_us, Senso
   return true;
 }
 
+FrameOutcome HwBridge::OnFrame(const DecodedFrame& frame, int64_t host_rx_us,
+                               SensorSample* sample) {
+  if (frame.type != FrameType::kSensor) return FrameOutcome::kUnexpectedType;
+  return OnSensorFrame(frame.sensor, host_rx_us, sample) ? FrameOutcome::kPublish
+                                                         : FrameOutcome::kDropped;
+}
+
 CommandVerdict HwBridge::OnForceCommand(int64_t utime, const Vector6d& force_n) {
   if (!force_n.allFinite()) {
     command_invalid_ = true;
@@ -157,6 +168,25 @@ std::size_t HwBridge::BuildCommandFrame(int64_t host_now_us, uint8_t* out) {
 bool HwBridge::LinkDown(int64_t host_now_us) const {
   if (!have_sample_) return true;
   return static_cast<double>(host_now_us - last_rx_host_us_) * 1e-6 > hw_.link_timeout_s;
+}
+
+LinkHealth HwBridge::Health(int64_t host_now_us, const std::string& link_description) const {
+  const uint16_t device_faults = last_device_status_ & (kStatusLegFault | kStatusImuFault |
+                                                        kStatusWatchdog | kStatusSupplyLow);
+  if (counters_.sensor_frames == 0) {
+    return {LinkState::kStarting, "no sensor frame from the device yet (" + link_description + ")"};
+  }
+  if (LinkDown(host_now_us)) {
+    return {LinkState::kFault, "device link down: no sensor frame for > link_timeout_s"};
+  }
+  if (last_reason_ != DriveReason::kCommand) {
+    return {LinkState::kDegraded,
+            std::string("zero drive: ") + ToString(last_reason_) + " safe command"};
+  }
+  if (device_faults != 0) {
+    return {LinkState::kDegraded, "device status " + std::to_string(last_device_status_)};
+  }
+  return {LinkState::kOk, ""};
 }
 
 }  // namespace stewart::hw

@@ -4,11 +4,13 @@
 
 #include <chrono>
 #include <cmath>
+#include <stdexcept>
 
 #include "stewart/node/eigen_msg.h"
-#include "stewart/node/lcm_handle.h"
 #include "stewart/node/node_loop.h"
 #include "stewart/node/stop_signal.h"
+#include "stewart/plant_sim/lockstep_pacing.h"
+#include "stewart/plant_sim/real_time_pacing.h"
 #include "stewart/sensor_t.hpp"
 #include "stewart/state_t.hpp"
 
@@ -17,39 +19,34 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-OdeOptions OdeOptionsFrom(const PlantSimConfig& c) {
-  OdeOptions o;
-  o.method = ParseOdeMethod(c.integrator);
-  o.rel_tol = c.rel_tol;
-  o.abs_tol = c.abs_tol;
-  return o;
-}
-
-int TimeoutMs(Clock::duration d) {
-  const auto ms = std::chrono::duration_cast<std::chrono::milliseconds>(d).count();
-  return static_cast<int>(std::max<int64_t>(0, std::min<int64_t>(ms, 50)));
+int64_t PeriodUs(double rate_hz) {
+  const int64_t period_us = std::llround(1e6 / rate_hz);
+  if (period_us <= 0) throw std::invalid_argument("sensors.rate_hz is too high (period < 1 us)");
+  return period_us;
 }
 
 }  // namespace
 
-PlantSimNode::PlantSimNode(const StackConfig& config, const PlantSimOptions& options)
+PlantSimNode::PlantSimNode(const StackConfig& config, lcm::LCM* lcm, const PlantSimOptions& options)
     : config_(config),
       options_(options),
-      lcm_(MakeLcm(config.lcm.url)),
+      lcm_(lcm),
       receiver_(config.lcm.url),
       plant_(PlantModel{config.platform, config.actuators}, OdeOptionsFrom(config.plant_sim)),
       sensors_(config.sensors, config.actuators, config.platform.gravity_mps2),
       health_("plant_sim", config.lcm.channels.health, config.lcm.health_rate_hz),
       hold_(config.plant_sim.command_timeout_s,
-            ParseTimeoutFallback(config.plant_sim.timeout_fallback)) {
-  period_us_ = std::llround(1e6 / config.sensors.rate_hz);
-  if (period_us_ <= 0) throw std::invalid_argument("sensors.rate_hz is too high (period < 1 us)");
+            ParseTimeoutFallback(config.plant_sim.timeout_fallback)),
+      period_us_(PeriodUs(config.sensors.rate_hz)),
+      gate_(options.mode == SimMode::kLockstep),
+      latency_tracker_(0, period_us_),
+      tick_accounting_(0, period_us_) {
   plant_.Reset(0.0, config.plant_sim.initial_pose, config.plant_sim.initial_velocity);
   receiver_.Subscribe(config.lcm.channels.command_safe, &PlantSimNode::HandleCommand, this);
 }
 
-int PlantSimNode::Run() {
-  int status = 0;
+ExitCode PlantSimNode::Run() {
+  ExitCode status = ExitCode::kOk;
   const Clock::time_point started = Clock::now();
   try {
     health_.SetState(health_t::STATE_OK);
@@ -58,11 +55,11 @@ int PlantSimNode::Run() {
     spdlog::error("plant_sim: {}", e.what());
     health_.SetState(health_t::STATE_FAULT);
     health_.SetError(e.what());
-    status = 4;
+    status = ExitCode::kIntegrationFailure;
   }
-  if (status == 0) health_.SetState(health_t::STATE_STOPPED);
+  if (status == ExitCode::kOk) health_.SetState(health_t::STATE_STOPPED);
   UpdateLatencyCounters();
-  health_.MaybePublish(lcm_.get(), true);
+  health_.MaybePublish(lcm_, true);
   spdlog::info(
       "plant_sim: sample-to-command latency p50 {} us, p99 {} us, max {} us ({} answered "
       "samples)",
@@ -104,9 +101,8 @@ void PlantSimNode::PublishSample() {
   if (plant_.InEndStop()) s.status |= sensor_t::STATUS_ENDSTOP;
   if (plant_.actuators_off()) s.status |= sensor_t::STATUS_ACTUATORS_OFF;
   lcm_->publish(config_.lcm.channels.sensors, &s);
-  const size_t slot = static_cast<size_t>(tick_ % kSentRing);
-  sent_sample_utime_[slot] = tick_utime_;
-  sent_at_[slot] = std::chrono::steady_clock::now();
+  latency_tracker_.OnPublished(tick_, tick_utime_, Clock::now());
+  gate_.OnSamplePublished(tick_utime_);
 
   state_t truth{};
   truth.utime = tick_utime_;
@@ -130,60 +126,30 @@ void PlantSimNode::AdvanceTick() {
     UpdateLatencyCounters();
     ReportReceiverCounters(receiver_, &health_);
   }
-  health_.MaybePublish(lcm_.get());
+  health_.MaybePublish(lcm_);
 }
 
 void PlantSimNode::HandleCommand(const lcm::ReceiveBuffer*, const std::string&,
                                  const force_command_t* msg) {
   health_.CountIn();
   const Vector6d force_n = FromArray(msg->force_n);
-  const std::string problem = ForceCommandProblem(force_n);
-  if (!problem.empty()) {
-    health_.Reject(problem, "force_command_t seq " + std::to_string(msg->seq));
-    return;
-  }
-  RecordLatency(msg->sample_utime);
-  if (options_.mode == SimMode::kLockstep) {
-    switch (MatchLockstepCommand(tick_utime_, msg->sample_utime)) {
-      case LockstepMatch::kAnswer:
-        if (answered_) {
-          health_.Reject("duplicate_answer", "sample_utime " + std::to_string(msg->sample_utime));
-          return;
-        }
-        answered_ = true;
-        answer_force_n_ = force_n;
-        return;
-      case LockstepMatch::kStale:
-        health_.Reject("stale_sample_utime", std::to_string(msg->sample_utime) + " < awaited " +
-                                                 std::to_string(tick_utime_));
-        return;
-      case LockstepMatch::kFuture:
-        health_.Reject("future_sample_utime", std::to_string(msg->sample_utime) + " > awaited " +
-                                                  std::to_string(tick_utime_));
-        return;
+  const CommandGate::Decision d = gate_.Check(force_n, msg->sample_utime, msg->seq);
+  if (d.timed) {
+    if (const auto latency_us =
+            latency_tracker_.OnCommand(msg->sample_utime, tick_, Clock::now())) {
+      latency_.Add(*latency_us);
     }
   }
-  if (msg->sample_utime > tick_utime_) {
-    health_.Reject("future_sample_utime", std::to_string(msg->sample_utime));
-    return;
+  switch (d.action) {
+    case CommandGate::Action::kReject:
+      health_.Reject(d.reason, d.detail);
+      return;
+    case CommandGate::Action::kAnswer:
+      return;
+    case CommandGate::Action::kApply:
+      hold_.OnCommand(force_n, plant_.time_s());
+      return;
   }
-  if (msg->sample_utime < last_applied_sample_utime_) {
-    health_.Reject("out_of_order", std::to_string(msg->sample_utime));
-    return;
-  }
-  last_applied_sample_utime_ = msg->sample_utime;
-  hold_.OnCommand(force_n, plant_.time_s());
-}
-
-void PlantSimNode::RecordLatency(int64_t sample_utime) {
-  if (sample_utime <= newest_timed_sample_utime_ || sample_utime < utime0_) return;
-  const int64_t tick = (sample_utime - utime0_) / period_us_;
-  const size_t slot = static_cast<size_t>(tick % kSentRing);
-  if (tick > tick_ || sent_sample_utime_[slot] != sample_utime) return;  // unknown or too old
-  newest_timed_sample_utime_ = sample_utime;
-  latency_.Add(std::chrono::duration_cast<std::chrono::microseconds>(
-                   std::chrono::steady_clock::now() - sent_at_[slot])
-                   .count());
 }
 
 void PlantSimNode::UpdateLatencyCounters() {
@@ -195,6 +161,14 @@ void PlantSimNode::UpdateLatencyCounters() {
     health_.SetCounter("tick_late_p99_us", tick_jitter_.Percentile(0.99));
     health_.SetCounter("tick_late_max_us", tick_jitter_.max_us());
   }
+}
+
+void PlantSimNode::UpdateTickCounters() {
+  const TickCounters& t = tick_accounting_.counters();
+  health_.SetCounter("overrun_ticks", t.overrun_ticks);
+  health_.SetCounter("missed_ticks", t.missed_ticks);
+  health_.SetCounter("missed_plant_late", t.missed_plant_late);
+  health_.SetCounter("missed_stack_late", t.missed_stack_late);
 }
 
 void PlantSimNode::ApplyRealTimeDecision() {
@@ -220,85 +194,53 @@ void PlantSimNode::ApplyRealTimeDecision() {
   health_.SetCounter("fallback_active", fallback_active_ ? 1 : 0);
 }
 
-int PlantSimNode::RunRealTime() {
+ExitCode PlantSimNode::RunRealTime() {
   utime0_ = options_.start_utime >= 0 ? options_.start_utime
                                       : std::chrono::duration_cast<std::chrono::microseconds>(
                                             std::chrono::system_clock::now().time_since_epoch())
                                             .count();
-  const auto period = std::chrono::microseconds(period_us_);
-  health_.SetCounter("overrun_ticks", 0);
-  health_.SetCounter("missed_ticks", 0);
-  health_.SetCounter("missed_plant_late", 0);
-  health_.SetCounter("missed_stack_late", 0);
-  const Clock::time_point start = Clock::now();
+  latency_tracker_ = LoopLatencyTracker(utime0_, period_us_);
+  tick_accounting_ = TickAccounting(utime0_, period_us_);
+  UpdateTickCounters();
+  const RealTimePacing pacing(period_us_, Clock::now());
   for (tick_ = 0;; ++tick_) {
-    const Clock::time_point deadline = start + tick_ * period;
-    // Commands are taken in while waiting for the tick; the one newest at
-    // the tick acts over the whole following interval (zero-order hold).
-    // Waiting on the socket until the deadline (not sleeping) takes each
-    // command in as it arrives, so its latency is measured when it lands.
+    const Clock::time_point deadline = pacing.Deadline(tick_);
     while (!StopRequested()) {
-      const Clock::duration left = deadline - Clock::now();
-      if (left <= Clock::duration::zero()) break;
-      receiver_.HandleTimeoutUs(std::min<int64_t>(
-          std::chrono::duration_cast<std::chrono::microseconds>(left).count() + 1, 50000));
+      const int64_t wait_us = RealTimePacing::WaitUs(deadline, Clock::now());
+      if (wait_us == 0) break;
+      receiver_.HandleTimeoutUs(wait_us);
     }
     while (receiver_.HandleTimeout(0) > 0) {
     }
     if (StopRequested()) break;
-    // Real-time bookkeeping (docs/simulation.md, "Real-time figures"):
-    // an overrun is a tick started more than one period after its deadline
-    // (the simulator itself fell behind); a missed tick is one whose previous
-    // sample got no command before this tick, so the stale one stays applied.
-    const Clock::duration late = Clock::now() - deadline;
-    tick_jitter_.Add(std::chrono::duration_cast<std::chrono::microseconds>(late).count());
-    if (late > period) {
-      health_.Count("overrun_ticks");
-      const int64_t overruns = health_.counter("overrun_ticks");
-      if (overruns <= 20 || overruns % 100 == 0) {  // the exceptional path only
-        spdlog::warn("plant_sim: tick {} started {} us late (overrun {})", tick_,
-                     std::chrono::duration_cast<std::chrono::microseconds>(late).count(), overruns);
-      }
-    }
-    if (tick_ > 0) {
-      const int64_t previous_sample_utime = utime0_ + (tick_ - 1) * period_us_;
-      if (last_applied_sample_utime_ < previous_sample_utime) {
-        health_.Count("missed_ticks");
-        // Whose: the stack had less than half a period when the plant itself
-        // published the previous sample late (it catches up on the wall clock).
-        const Clock::duration window =
-            Clock::now() - sent_at_[static_cast<size_t>((tick_ - 1) % kSentRing)];
-        health_.Count(window < period / 2 ? "missed_plant_late" : "missed_stack_late");
-      }
+    const TickAccounting::Outcome outcome = tick_accounting_.OnTickStart(
+        tick_, deadline, Clock::now(), gate_.last_applied_sample_utime(), latency_tracker_);
+    UpdateTickCounters();
+    tick_jitter_.Add(outcome.late_us);
+    if (outcome.log_overrun) {
+      spdlog::warn("plant_sim: tick {} started {} us late (overrun {})", tick_, outcome.late_us,
+                   tick_accounting_.counters().overrun_ticks);
     }
     PublishSample();
     if (options_.duration_s > 0.0 && plant_.time_s() >= options_.duration_s - 1e-9) break;
     ApplyRealTimeDecision();
     AdvanceTick();
   }
-  return 0;
+  return ExitCode::kOk;
 }
 
-namespace {
-constexpr std::chrono::milliseconds kStallResend(200);
-}  // namespace
-
-int PlantSimNode::RunLockstep() {
+ExitCode PlantSimNode::RunLockstep() {
   utime0_ = std::max<int64_t>(options_.start_utime, 0);
-  const auto timeout = std::chrono::duration_cast<Clock::duration>(
-      std::chrono::duration<double>(config_.plant_sim.lockstep_timeout_s));
-  const auto republish = std::chrono::duration_cast<Clock::duration>(
-      std::chrono::duration<double>(options_.startup_republish_s));
+  latency_tracker_ = LoopLatencyTracker(utime0_, period_us_);
+  LockstepPacing pacing(config_.plant_sim.lockstep_timeout_s, options_.startup_republish_s);
   for (tick_ = 0;; ++tick_) {
-    answered_ = false;
     PublishSample();
     if (options_.duration_s > 0.0 && plant_.time_s() >= options_.duration_s - 1e-9) break;
-    const Clock::time_point waiting_since = Clock::now();
-    Clock::time_point last_sent = waiting_since;
-    while (!answered_) {
-      if (StopRequested()) return 0;
-      const Clock::time_point now = Clock::now();
-      if (now - waiting_since >= timeout) {
+    pacing.StartWaiting(tick_, Clock::now());
+    while (!gate_.answered()) {
+      if (StopRequested()) return ExitCode::kOk;
+      const LockstepPacing::Step step = pacing.Poll(Clock::now());
+      if (step.timed_out) {
         const std::string what = "lockstep: no force_command_t on " +
                                  config_.lcm.channels.command_safe + " with sample_utime " +
                                  std::to_string(tick_utime_) + " (tick " + std::to_string(tick_) +
@@ -307,29 +249,19 @@ int PlantSimNode::RunLockstep() {
         spdlog::error("plant_sim: {}", what);
         health_.SetState(health_t::STATE_FAULT);
         health_.SetError(what);
-        return 3;
+        return ExitCode::kLockstepTimeout;
       }
-      // Resend the awaited sample: at start-up until the stack has
-      // subscribed, later when the loop stalls. On a saturated machine a
-      // multicast datagram was seen to wait in the kernel for seconds (or is
-      // lost), and lockstep has nothing else to move it along; a receiver
-      // that already has the sample rejects the copy by its utime.
-      const Clock::duration resend_every = tick_ == 0 ? republish : kStallResend;
-      const bool resend_enabled = tick_ > 0 || options_.startup_republish_s > 0.0;
-      if (resend_enabled && now - last_sent >= resend_every) {
-        // The stored message, byte for byte: a new draw would change the noise sequence.
+      if (step.resend) {
         lcm_->publish(config_.lcm.channels.sensors, &last_sensor_);
         if (tick_ > 0) health_.Count("lockstep_resends");
-        last_sent = now;
       }
-      const Clock::duration remaining = timeout - (now - waiting_since);
-      receiver_.HandleTimeout(TimeoutMs(std::min<Clock::duration>(remaining, resend_every)));
-      health_.MaybePublish(lcm_.get());
+      receiver_.HandleTimeout(step.wait_ms);
+      health_.MaybePublish(lcm_);
     }
-    plant_.SetForceCommand(answer_force_n_);
+    plant_.SetForceCommand(gate_.answer_force_n());
     AdvanceTick();
   }
-  return 0;
+  return ExitCode::kOk;
 }
 
 }  // namespace stewart

@@ -2,20 +2,22 @@
 // The plant_sim process: the simulated platform on LCM (docs/simulation.md).
 // Publishes sensor_t and the ground-truth state_t at every tick, health_t as
 // a heartbeat, and applies force_command_t from the safety filter.
-#include <array>
 #include <chrono>
 #include <lcm/lcm-cpp.hpp>
-#include <memory>
 #include <string>
 
 #include "stewart/config/stack_config.h"
 #include "stewart/force_command_t.hpp"
+#include "stewart/node/exit_code.h"
 #include "stewart/node/health_reporter.h"
 #include "stewart/node/latency_histogram.h"
 #include "stewart/node/lcm_receiver.h"
+#include "stewart/plant_sim/command_gate.h"
 #include "stewart/plant_sim/command_policy.h"
+#include "stewart/plant_sim/loop_latency_tracker.h"
 #include "stewart/plant_sim/plant.h"
 #include "stewart/plant_sim/sensor_model.h"
+#include "stewart/plant_sim/tick_accounting.h"
 #include "stewart/sensor_t.hpp"
 
 namespace stewart {
@@ -34,25 +36,25 @@ struct PlantSimOptions {
 
 class PlantSimNode {
  public:
-  PlantSimNode(const StackConfig& config, const PlantSimOptions& options);
-  /// Runs to the end of the duration or a stop signal. Returns the exit status:
-  /// 0 clean, 3 lockstep timeout, 4 integration failure.
-  int Run();
+  PlantSimNode(const StackConfig& config, lcm::LCM* lcm, const PlantSimOptions& options);
+  /// Runs to the end of the duration or a stop signal: kOk, kLockstepTimeout
+  /// or kIntegrationFailure.
+  ExitCode Run();
 
  private:
-  int RunRealTime();
-  int RunLockstep();
+  ExitCode RunRealTime();
+  ExitCode RunLockstep();
   void PublishSample();
   void ApplyRealTimeDecision();
   void AdvanceTick();
   void HandleCommand(const lcm::ReceiveBuffer* rbuf, const std::string& channel,
                      const force_command_t* msg);
-  void RecordLatency(int64_t sample_utime);
   void UpdateLatencyCounters();
+  void UpdateTickCounters();
 
   StackConfig config_;
   PlantSimOptions options_;
-  std::unique_ptr<lcm::LCM> lcm_;
+  lcm::LCM* lcm_;
   LcmReceiver receiver_;
   Plant plant_;
   SensorModel sensors_;
@@ -62,17 +64,11 @@ class PlantSimNode {
   int64_t utime0_ = 0;
   int64_t tick_ = 0;        // index of the newest published sample
   int64_t tick_utime_ = 0;  // its utime
-  int64_t last_applied_sample_utime_ = -1;
-  bool answered_ = false;  // lockstep: the command for tick_ arrived
-  Vector6d answer_force_n_ = Vector6d::Zero();
   bool fallback_active_ = false;
   sensor_t last_sensor_{};
-  // The loop's latency as the plant sees it: from publishing sample k to
-  // receiving the first command derived from it (wall clock, both ends here).
-  static constexpr int kSentRing = 64;
-  std::array<int64_t, kSentRing> sent_sample_utime_{};
-  std::array<std::chrono::steady_clock::time_point, kSentRing> sent_at_{};
-  int64_t newest_timed_sample_utime_ = -1;
+  CommandGate gate_;
+  LoopLatencyTracker latency_tracker_;
+  TickAccounting tick_accounting_;
   LatencyHistogram latency_;
   LatencyHistogram tick_jitter_;  // real time: tick start after its deadline
 };

@@ -16,6 +16,14 @@
 
 namespace stewart {
 
+OdeOptions OdeOptionsFrom(const PlantSimConfig& config) {
+  OdeOptions o;
+  o.method = ParseOdeMethod(config.integrator);
+  o.rel_tol = config.rel_tol;
+  o.abs_tol = config.abs_tol;
+  return o;
+}
+
 OdeMethod ParseOdeMethod(const std::string& name) {
   if (name == "arkode_erk") return OdeMethod::kArkodeErk;
   if (name == "cvode_bdf") return OdeMethod::kCvodeBdf;

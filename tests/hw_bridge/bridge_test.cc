@@ -190,6 +190,60 @@ TEST_F(BridgeTest, LinkDownAfterTimeout) {
   EXPECT_TRUE(bridge_.LinkDown(host_now_ + static_cast<int64_t>(hw_.link_timeout_s * 1e6) + 1));
 }
 
+TEST_F(BridgeTest, OnlySensorFramesArePublishedOnce) {
+  DecodedFrame command;
+  command.type = FrameType::kCommand;
+  EXPECT_EQ(bridge_.OnFrame(command, kHostEpoch, &sample_), FrameOutcome::kUnexpectedType);
+  DecodedFrame sensor;
+  sensor.type = FrameType::kSensor;
+  sensor.sensor.seq = 4;
+  sensor.sensor.adc.fill(2000);
+  EXPECT_EQ(bridge_.OnFrame(sensor, kHostEpoch, &sample_), FrameOutcome::kPublish);
+  EXPECT_EQ(sample_.seq, 4);
+  EXPECT_EQ(bridge_.OnFrame(sensor, kHostEpoch + 10, &sample_), FrameOutcome::kDropped);
+  EXPECT_EQ(bridge_.counters().reordered_frames, 1U);
+}
+
+TEST(CommandVerdict, AValidOrNonFiniteCommandGoesOutAtOnce) {
+  EXPECT_TRUE(SendsAtOnce(CommandVerdict::kAccepted));
+  EXPECT_TRUE(SendsAtOnce(CommandVerdict::kNonFinite));
+  EXPECT_FALSE(SendsAtOnce(CommandVerdict::kOutOfOrder));
+  EXPECT_FALSE(SendsAtOnce(CommandVerdict::kFuture));
+}
+
+TEST_F(BridgeTest, HealthReportsTheWorstConditionFirst) {
+  LinkHealth h = bridge_.Health(kHostEpoch, "udp test");
+  EXPECT_EQ(h.state, LinkState::kStarting);
+  EXPECT_EQ(h.error, "no sensor frame from the device yet (udp test)");
+
+  Deliver(0);
+  Send();  // no command yet: zero drive
+  h = bridge_.Health(host_now_, "udp test");
+  EXPECT_EQ(h.state, LinkState::kDegraded);
+  EXPECT_EQ(h.error, "zero drive: missing safe command");
+
+  ASSERT_EQ(bridge_.OnForceCommand(sample_.utime, Vector6d::Constant(10.0)),
+            CommandVerdict::kAccepted);
+  Send();
+  h = bridge_.Health(host_now_, "udp test");
+  EXPECT_EQ(h.state, LinkState::kOk);
+  EXPECT_EQ(h.error, "");
+
+  SensorFrame f;
+  f.seq = 1;
+  f.device_time_us = 1000;
+  f.adc.fill(2000);
+  f.status = kStatusSupplyLow;
+  ASSERT_TRUE(bridge_.OnSensorFrame(f, host_now_ + 1000, &sample_));
+  h = bridge_.Health(host_now_ + 1000, "udp test");
+  EXPECT_EQ(h.state, LinkState::kDegraded);
+  EXPECT_EQ(h.error, "device status " + std::to_string(kStatusSupplyLow));
+
+  h = bridge_.Health(host_now_ + 1000 + static_cast<int64_t>(hw_.link_timeout_s * 1e6) + 1, "x");
+  EXPECT_EQ(h.state, LinkState::kFault);
+  EXPECT_EQ(h.error, "device link down: no sensor frame for > link_timeout_s");
+}
+
 TEST(DeviceClockMap, TracksDriftWithinTheBoundAndResetsOnReboot) {
   DeviceClockMap map(200.0);
   // Device clock 100 ppm slow: host advances 1.0001 ms per device ms.

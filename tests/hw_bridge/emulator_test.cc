@@ -7,6 +7,7 @@
 #include "stewart/hw_bridge/bridge.h"
 #include "stewart/hw_emulator/device_emulator.h"
 #include "stewart/hw_emulator/plant_backend.h"
+#include "stewart/hw_emulator/sample_schedule.h"
 #include "stewart/model/kinematics.h"
 #include "stewart/plant_sim/plant.h"
 #include "stewart/plant_sim/sensor_model.h"
@@ -112,6 +113,36 @@ std::unique_ptr<PlantBackend> MakeBackend(bool noise) {
   PlantBackendOptions o;
   o.noise = noise;
   return std::make_unique<PlantBackend>(c, c.home_pose, Vector6d::Zero(), o);
+}
+
+TEST(SampleSchedule, SamplesOnThePeriodGridAndDropsEveryNth) {
+  SampleSchedule schedule(1000, 3);
+  const uint64_t t0 = SampleSchedule::kDeviceEpochUs;
+  EXPECT_FALSE(schedule.Due(t0 + 999));
+  EXPECT_TRUE(schedule.Due(t0 + 1000));
+  std::vector<bool> sent;
+  for (int k = 1; k <= 6; ++k) {
+    const SampleSchedule::Sample s = schedule.Take(t0 + 1000 * k + 400);  // late, but on the grid
+    EXPECT_EQ(s.time_us, t0 + 1000 * static_cast<uint64_t>(k));
+    sent.push_back(s.send);
+  }
+  EXPECT_EQ(sent, (std::vector<bool>{true, true, false, true, true, false}));
+  EXPECT_EQ(schedule.ticks(), 6U);
+  EXPECT_EQ(schedule.skipped(), 0U);
+}
+
+TEST(SampleSchedule, SkipsTheBacklogAfterBeingDescheduled) {
+  SampleSchedule schedule(1000, 0);
+  const uint64_t t0 = SampleSchedule::kDeviceEpochUs;
+  // Ten periods behind: still caught up sample by sample.
+  EXPECT_EQ(schedule.Take(t0 + 11'000).time_us, t0 + 1000);
+  EXPECT_EQ(schedule.skipped(), 0U);
+  // Far behind: one sample at the newest grid point, the rest skipped.
+  const SampleSchedule::Sample s = schedule.Take(t0 + 50'500);
+  EXPECT_EQ(s.time_us, t0 + 50'000);
+  EXPECT_TRUE(s.send);
+  EXPECT_EQ(schedule.skipped(), 48U);
+  EXPECT_EQ(schedule.next_tick_us(), t0 + 51'000);
 }
 
 TEST(PlantBackend, UnpoweredLegsHoldThePose) {

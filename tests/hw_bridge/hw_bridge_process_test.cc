@@ -153,8 +153,7 @@ void ExpectSaneSamples(const Stack& stack, std::size_t held) {
     // stop and the device zeroes the drive, the lead screws lock the moving
     // legs (Plant's lock: the end-stop spring and damper, c / m ~ 1e4 1/s):
     // a sample that falls in that sub-millisecond transient truly reads a
-    // deceleration of a g or more (measured: in ~1 of 30 runs, up to 5 g, at
-    // the sample where the lock engages).
+    // deceleration of a g or more, at the sample where the lock engages.
     if (k < held) {
       EXPECT_NEAR(s.accel_mps2[2], p.gravity_mps2, 1.0) << "sample " << k;
       EXPECT_LT(std::abs(s.gyro_radps[0]), 0.1) << "sample " << k;

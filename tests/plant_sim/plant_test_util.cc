@@ -10,11 +10,9 @@ const StackConfig& Config() {
 PlantModel DefaultModel() { return PlantModel{Config().platform, Config().actuators}; }
 
 OdeOptions OdeOptionsFor(const std::string& integrator) {
-  OdeOptions o;
-  o.method = ParseOdeMethod(integrator);
-  o.rel_tol = Config().plant_sim.rel_tol;
-  o.abs_tol = Config().plant_sim.abs_tol;
-  return o;
+  PlantSimConfig plant_sim = Config().plant_sim;
+  plant_sim.integrator = integrator;
+  return OdeOptionsFrom(plant_sim);
 }
 
 Vector6d HoldingForce(const PlatformParams& platform, const Vector6d& q) {

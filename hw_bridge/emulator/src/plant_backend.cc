@@ -11,14 +11,6 @@ namespace {
 // STATUS_ENDSTOP: a leg within this of a stroke end (docs/wire-protocol.md).
 constexpr double kEndstopBandM = 5e-4;
 
-OdeOptions OdeOptionsOf(const PlantSimConfig& c) {
-  OdeOptions o;
-  o.method = ParseOdeMethod(c.integrator);
-  o.rel_tol = c.rel_tol;
-  o.abs_tol = c.abs_tol;
-  return o;
-}
-
 SensorConfig SensorsOf(const SensorConfig& sensors, bool noise) {
   SensorConfig s = sensors;
   if (!noise) {
@@ -36,7 +28,7 @@ SensorConfig SensorsOf(const SensorConfig& sensors, bool noise) {
 
 PlantBackend::PlantBackend(const StackConfig& config, const Vector6d& q0, const Vector6d& qd0,
                            const PlantBackendOptions& options)
-    : plant_(PlantModel{config.platform, config.actuators}, OdeOptionsOf(config.plant_sim)),
+    : plant_(PlantModel{config.platform, config.actuators}, OdeOptionsFrom(config.plant_sim)),
       sensors_(SensorsOf(config.sensors, options.noise), config.actuators,
                config.platform.gravity_mps2),
       calibration_(config.hw_bridge, config.actuators.min_length_m, config.actuators.stroke_m),

@@ -1,14 +1,16 @@
 #pragma once
 // The host side of the device link, without LCM: sensor frames -> SI
 // samples in the stack's time base, safe force commands -> command frames,
-// with the command watchdog and the link statistics. hw_bridge_main wires it
-// to LCM and a Transport.
+// with the command watchdog and the link statistics, and what the node
+// reports about the link. BridgeNode (hw_bridge/node) wires it to LCM and a
+// Transport.
 #include <cstddef>
 #include <cstdint>
+#include <string>
 
-#include "stewart/hw_bridge/hw_bridge_config.h"
 #include "stewart/hw_bridge/calibration.h"
 #include "stewart/hw_bridge/drive_map.h"
+#include "stewart/hw_bridge/hw_bridge_config.h"
 #include "stewart/hw_bridge/link_stats.h"
 #include "stewart/hw_bridge/wire_format.h"
 #include "stewart/model/types.h"
@@ -43,6 +45,25 @@ enum class CommandVerdict {
 };
 const char* ToString(CommandVerdict verdict);
 
+/// Whether a command frame goes out as soon as the command is in: a valid
+/// command at once, and a non-finite one at once as zero drive. An ignored
+/// command changes nothing the device must hear about.
+bool SendsAtOnce(CommandVerdict verdict);
+
+/// What a decoded frame from the device means for the node.
+enum class FrameOutcome {
+  kPublish,         ///< a new sensor sample: publish it
+  kDropped,         ///< a sensor frame not to publish (duplicate, reordered)
+  kUnexpectedType,  ///< not a sensor frame: the device never sends one
+};
+
+/// The link's state as the heartbeat reports it.
+enum class LinkState { kStarting, kOk, kDegraded, kFault };
+struct LinkHealth {
+  LinkState state = LinkState::kStarting;
+  std::string error;  ///< "" when kOk
+};
+
 struct BridgeCounters {
   uint64_t sensor_frames = 0;
   uint64_t lost_frames = 0;       ///< sensor seq gaps
@@ -71,6 +92,8 @@ class HwBridge {
   /// A decoded sensor frame that arrived at host_rx_us. Returns false (and
   /// counts) when it must not be published: duplicate or reordered.
   bool OnSensorFrame(const SensorFrame& frame, int64_t host_rx_us, SensorSample* sample);
+  /// Any decoded frame from the device; *sample is set for kPublish.
+  FrameOutcome OnFrame(const DecodedFrame& frame, int64_t host_rx_us, SensorSample* sample);
 
   /// A safe command (force_command_t.utime, force_n).
   CommandVerdict OnForceCommand(int64_t utime, const Vector6d& force_n);
@@ -86,6 +109,9 @@ class HwBridge {
   DriveReason last_reason() const { return last_reason_; }
   /// No sensor frame for link_timeout_s (or none yet).
   bool LinkDown(int64_t host_now_us) const;
+  /// The heartbeat's state and error, worst first: no frame yet, link down,
+  /// zero drive, device fault bits. `link_description` names the transport.
+  LinkHealth Health(int64_t host_now_us, const std::string& link_description) const;
   int64_t latest_sample_utime() const { return latest_sample_utime_; }
   uint16_t last_device_status() const { return last_device_status_; }
   const BridgeCounters& counters() const { return counters_; }

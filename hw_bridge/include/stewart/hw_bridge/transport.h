@@ -6,6 +6,8 @@
 #include <memory>
 #include <string>
 
+#include "stewart/hw_bridge/hw_bridge_config.h"
+
 namespace stewart::hw {
 
 class Transport {
@@ -71,6 +73,11 @@ class FdStreamTransport : public Transport {
 /// Opens a serial device raw (8N1, no flow control, no echo) at `baud`.
 /// Throws std::runtime_error naming the device and the reason.
 std::unique_ptr<FdStreamTransport> OpenSerial(const std::string& device, int baud);
+
+/// The host's end of the link hw_bridge.transport names: "serial" opens
+/// serial_device, anything else binds UDP local_host:local_port towards
+/// device_host:device_port.
+std::unique_ptr<Transport> OpenHostTransport(const HwBridgeConfig& hw);
 
 /// A pseudo-terminal pair: the master end as a transport (the emulator's
 /// device side) and the slave path a SerialTransport opens. The slave is kept

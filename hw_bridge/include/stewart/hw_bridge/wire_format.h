@@ -154,4 +154,39 @@ void StreamParser::Feed(const uint8_t* data, std::size_t size, OnFrame&& on_fram
   }
 }
 
+/// The frames in what one Transport::Receive() returned, whichever the
+/// transport: a datagram holds one frame, a byte stream is reassembled.
+class FrameReader {
+ public:
+  explicit FrameReader(bool datagram) : datagram_(datagram) {}
+
+  /// `size` bytes received into a buffer of `capacity` (a datagram longer
+  /// than the buffer arrives truncated: kBadLength). Calls on_frame and
+  /// on_error as StreamParser::Feed does.
+  template <typename OnFrame, typename OnError>
+  void Feed(const uint8_t* data, std::size_t size, std::size_t capacity, OnFrame&& on_frame,
+            OnError&& on_error) {
+    if (!datagram_) {
+      parser_.Feed(data, size, on_frame, on_error);
+      return;
+    }
+    DecodedFrame frame;
+    const DecodeStatus status =
+        size > capacity ? DecodeStatus::kBadLength : DecodeDatagram(data, size, &frame);
+    datagram_stats_.Count(status);
+    if (status == DecodeStatus::kOk) {
+      on_frame(static_cast<const DecodedFrame&>(frame));
+    } else {
+      on_error(status);
+    }
+  }
+
+  const RxStats& stats() const { return datagram_ ? datagram_stats_ : parser_.stats(); }
+
+ private:
+  bool datagram_;
+  StreamParser parser_;
+  RxStats datagram_stats_;
+};
+
 }  // namespace stewart::hw

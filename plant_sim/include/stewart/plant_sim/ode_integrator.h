@@ -1,15 +1,17 @@
 #pragma once
 // A thin RAII wrapper over the SUNDIALS 6.4 integrators the simulator can
-// use (docs/simulation.md, "Integrator" gives the measured choice):
+// use (docs/simulation.md, "Integrator", says which and why):
 //   kArkodeErk   ARKODE ERKStep, explicit adaptive Runge-Kutta, order 5
 //                (Cash-Karp 6-4-5); a restart (ERKStepReset) keeps the step
 //                size, so a restart at every force change costs one extra
-//                right-hand side and one 1 ms tick is usually one step.
+//                right-hand side and one control tick is usually one step.
 //   kCvodeBdf    CVODE BDF (orders 1-5) with a dense direct linear solver.
 //   kCvodeAdams  CVODE Adams-Moulton (orders 1-12), fixed-point iteration.
 // The system size and the number of root functions are fixed at construction.
 #include <memory>
 #include <string>
+
+#include "stewart/plant_sim/plant_sim_config.h"
 
 namespace stewart {
 
@@ -38,6 +40,10 @@ struct OdeOptions {
   double abs_tol = 1e-10;
   int erk_order = 5;  ///< kArkodeErk only: ARKODE's default table of this order (2-8)
 };
+
+/// The integrator and tolerances of the `plant_sim` section; throws
+/// std::invalid_argument for an unknown integrator.
+OdeOptions OdeOptionsFrom(const PlantSimConfig& config);
 
 class OdeIntegrator {
  public:

@@ -5,10 +5,9 @@
 //
 // Why: Debian 12's SUNDIALS 6.4 (libsundials-dev 6.4.1) is built without
 // optimisation: its serial kernels keep loop counters and pointers on the
-// stack, ~20 instructions per element. On the 18-value plant state one ERK
-// step made ~27 such calls (most from N_VLinearCombination falling back to a
-// chain of N_VLinearSum), about 40 % of a 1 ms plant tick by callgrind and
-// perf (docs/performance.md, "plant_sim"). These are plain loops the compiler
+// stack. One ERK step on the 18-value plant state makes many such calls (most
+// from N_VLinearCombination falling back to a chain of N_VLinearSum), enough
+// to dominate a plant tick (docs/performance.md, "plant_sim"). These are plain loops the compiler
 // vectorises; the arithmetic per element is the textbook one (z = a x + b y,
 // sums accumulated in index order), so results agree with the library's
 // kernels to round-off (tests/plant_sim/serial_vector_kernels_test.cc).

@@ -1,7 +1,7 @@
 #pragma once
 // The device side of the wire protocol (docs/wire-protocol.md): holds the
 // latest command under the device watchdog, runs a backend in device time,
-// and produces a sensor frame per sample. No I/O: hw_emulator_main drives it.
+// and produces a sensor frame per sample. No I/O: EmulatorNode drives it.
 //
 // Time is the device clock (us). The backend's physics is advanced event by
 // event: a command frame takes effect at the instant it arrives (as the

@@ -1,0 +1,142 @@
+#include "bridge_node.h"
+
+#include <poll.h>
+
+#include "stewart/node/eigen_msg.h"
+#include "stewart/node/node_loop.h"
+#include "stewart/node/stop_signal.h"
+#include "stewart/sensor_t.hpp"
+
+namespace stewart {
+namespace {
+
+int8_t HealthState(hw::LinkState state) {
+  switch (state) {
+    case hw::LinkState::kStarting:
+      return health_t::STATE_STARTING;
+    case hw::LinkState::kOk:
+      return health_t::STATE_OK;
+    case hw::LinkState::kDegraded:
+      return health_t::STATE_DEGRADED;
+    case hw::LinkState::kFault:
+      return health_t::STATE_FAULT;
+  }
+  return health_t::STATE_FAULT;
+}
+
+}  // namespace
+
+BridgeNode::BridgeNode(const StackConfig& config, lcm::LCM* lcm, hw::Transport* transport)
+    : config_(config),
+      lcm_(lcm),
+      receiver_(config.lcm.url),
+      transport_(transport),
+      bridge_(config.hw_bridge, config.platform.leg_min_length_m,
+              config.platform.leg_max_length_m - config.platform.leg_min_length_m,
+              config.actuators.force_limit_n),
+      health_("hw_bridge", config.lcm.channels.health, config.lcm.health_rate_hz),
+      reader_(transport->datagram()) {
+  receiver_.Subscribe(config.lcm.channels.command_safe, &BridgeNode::OnCommand, this);
+}
+
+ExitCode BridgeNode::Run() {
+  std::array<pollfd, 2> fds{pollfd{transport_->fd(), POLLIN, 0}, pollfd{receiver_.fd(), POLLIN, 0}};
+  while (!StopRequested()) {
+    const int ready = poll(fds.data(), fds.size(), 5);
+    if (ready > 0 && (fds[0].revents & (POLLIN | POLLERR | POLLHUP)) != 0) ReadDevice();
+    if (ready > 0 && (fds[1].revents & POLLIN) != 0) receiver_.HandleTimeout(0);
+    UpdateHealth();
+  }
+  health_.SetState(health_t::STATE_STOPPED);
+  health_.MaybePublish(lcm_, true);
+  return ExitCode::kOk;
+}
+
+void BridgeNode::ReadDevice() {
+  for (int i = 0; i < 64; ++i) {
+    const long n = transport_->Receive(rx_.data(), rx_.size(), 0);
+    if (n == 0) return;
+    if (n < 0) {
+      health_.Count("transport_errors");
+      return;
+    }
+    reader_.Feed(
+        rx_.data(), static_cast<std::size_t>(n), rx_.size(),
+        [this](const hw::DecodedFrame& f) { OnFrame(f); },
+        [this](hw::DecodeStatus s) { health_.Reject("corrupt_frame", ToString(s)); });
+  }
+}
+
+void BridgeNode::OnFrame(const hw::DecodedFrame& frame) {
+  hw::SensorSample sample;
+  const hw::FrameOutcome outcome = bridge_.OnFrame(frame, clock_.NowMicros(), &sample);
+  if (outcome == hw::FrameOutcome::kUnexpectedType) {
+    health_.Reject("unexpected_frame_type");
+    return;
+  }
+  health_.CountIn();
+  if (outcome != hw::FrameOutcome::kPublish) return;
+  sensor_t msg{};
+  msg.utime = sample.utime;
+  msg.seq = sample.seq;
+  msg.sample_utime = sample.utime;
+  ToArray(sample.leg_length_m, msg.leg_length_m);
+  ToArray(sample.gyro_radps, msg.gyro_radps);
+  ToArray(sample.accel_mps2, msg.accel_mps2);
+  msg.has_orientation = false;
+  msg.status = sample.status;
+  lcm_->publish(config_.lcm.channels.sensors, &msg);
+  health_.CountOut();
+  health_.SetStackTime(sample.utime, sample.utime);
+  if (bridge_.TickFrameDue()) SendCommand();
+}
+
+void BridgeNode::OnCommand(const lcm::ReceiveBuffer*, const std::string&,
+                           const force_command_t* msg) {
+  health_.CountIn();
+  const hw::CommandVerdict verdict = bridge_.OnForceCommand(msg->utime, FromArray(msg->force_n));
+  if (verdict != hw::CommandVerdict::kAccepted) health_.Reject(ToString(verdict));
+  if (hw::SendsAtOnce(verdict)) SendCommand();
+}
+
+void BridgeNode::SendCommand() {
+  std::array<uint8_t, hw::kMaxFrameSize> frame{};
+  const std::size_t size = bridge_.BuildCommandFrame(clock_.NowMicros(), frame.data());
+  if (!transport_->Send(frame.data(), size)) health_.Count("send_errors");
+}
+
+void BridgeNode::UpdateHealth() {
+  const hw::BridgeCounters& c = bridge_.counters();
+  const hw::RxStats& rx = reader_.stats();
+  ReportReceiverCounters(receiver_, &health_);
+  health_.SetCounter("sensor_frames", static_cast<int64_t>(c.sensor_frames));
+  health_.SetCounter("lost_frames", static_cast<int64_t>(c.lost_frames));
+  health_.SetCounter("corrupt_frames", static_cast<int64_t>(rx.corrupt()));
+  health_.SetCounter("late_frames", static_cast<int64_t>(c.late_frames));
+  health_.SetCounter("reordered_frames", static_cast<int64_t>(c.reordered_frames));
+  health_.SetCounter("stream_bytes_skipped", static_cast<int64_t>(rx.bytes_skipped));
+  health_.SetCounter("rtt_us_mean", c.rtt_us.mean());
+  health_.SetCounter("rtt_us_max", c.rtt_us.max);
+  health_.SetCounter("rtt_samples", c.rtt_us.count);
+  health_.SetCounter("delay_us_mean", c.delay_us.mean());
+  health_.SetCounter("delay_us_max", c.delay_us.max);
+  health_.SetCounter("command_frames", static_cast<int64_t>(c.command_frames));
+  health_.SetCounter("commands_accepted", static_cast<int64_t>(c.commands_accepted));
+  health_.SetCounter("zero_drive_frames", static_cast<int64_t>(c.zero_drive_frames));
+  health_.SetCounter("zero_drive", bridge_.last_reason() != hw::DriveReason::kCommand ? 1 : 0);
+  health_.SetCounter("force_clamped", static_cast<int64_t>(c.force_clamped));
+  health_.SetCounter("duty_clamped", static_cast<int64_t>(c.duty_clamped));
+  health_.SetCounter("force_deadzoned", static_cast<int64_t>(c.force_deadzoned));
+  health_.SetCounter("leg_fault_samples", static_cast<int64_t>(c.leg_fault_samples));
+  health_.SetCounter("imu_fault_samples", static_cast<int64_t>(c.imu_fault_samples));
+  health_.SetCounter("device_watchdog_samples", static_cast<int64_t>(c.device_watchdog_samples));
+  health_.SetCounter("device_rx_corrupt", static_cast<int64_t>(c.device_rx_corrupt));
+  health_.SetCounter("device_rx_lost", static_cast<int64_t>(c.device_rx_lost));
+
+  const hw::LinkHealth link = bridge_.Health(clock_.NowMicros(), transport_->description());
+  health_.SetState(HealthState(link.state));
+  health_.SetError(link.error);
+  if (health_.MaybePublish(lcm_)) bridge_.ResetWindows();
+}
+
+}  // namespace stewart

@@ -1,0 +1,50 @@
+#pragma once
+// The hw_bridge process's node: sensor frames from the device -> sensor_t on
+// channels.sensors (as plant_sim publishes them), force_command_t from
+// channels.command_safe -> command frames (docs/wire-protocol.md). What to do
+// with each frame, command and silence is hw::HwBridge's; this class only
+// moves bytes and messages and reports the heartbeat.
+#include <array>
+#include <cstdint>
+#include <lcm/lcm-cpp.hpp>
+#include <string>
+
+#include "stewart/config/stack_config.h"
+#include "stewart/force_command_t.hpp"
+#include "stewart/hw_bridge/bridge.h"
+#include "stewart/hw_bridge/host_clock.h"
+#include "stewart/hw_bridge/transport.h"
+#include "stewart/hw_bridge/wire_format.h"
+#include "stewart/node/exit_code.h"
+#include "stewart/node/health_reporter.h"
+#include "stewart/node/lcm_receiver.h"
+
+namespace stewart {
+
+class BridgeNode {
+ public:
+  BridgeNode(const StackConfig& config, lcm::LCM* lcm, hw::Transport* transport);
+
+  /// Runs until a stop signal; kOk.
+  ExitCode Run();
+
+ private:
+  void ReadDevice();
+  void OnFrame(const hw::DecodedFrame& frame);
+  void OnCommand(const lcm::ReceiveBuffer* rbuf, const std::string& channel,
+                 const force_command_t* msg);
+  void SendCommand();
+  void UpdateHealth();
+
+  const StackConfig& config_;
+  lcm::LCM* lcm_;
+  LcmReceiver receiver_;
+  hw::Transport* transport_;
+  hw::HwBridge bridge_;
+  HealthReporter health_;
+  hw::HostClock clock_;
+  hw::FrameReader reader_;
+  std::array<uint8_t, 4096> rx_{};
+};
+
+}  // namespace stewart
