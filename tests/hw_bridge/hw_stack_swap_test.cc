@@ -22,16 +22,8 @@
 #include "stewart/test_support/recorded_run.h"
 #include "stewart/test_support/stack_launch.h"
 
-namespace stewart {
+namespace stewart::test {
 namespace {
-
-using test_support::Bound;
-using test_support::FormatNumber;
-using test_support::kLaunchTimeoutS;
-using test_support::kLimitTolerance;
-using test_support::ReadFile;
-using test_support::RecordedRun;
-using test_support::ShellQuote;
 
 constexpr int kLcmPort = 7840;      // this folder's launcher tests: 7840-7849
 constexpr int kDevicePort = 17700;  // device UDP ports: 17700-17749
@@ -49,7 +41,7 @@ void WriteConfig(const std::string& path) {
   out << root << "\n";
 }
 
-class HwBridgeStackSwap : public test_support::WithRunFolder<::testing::Test> {
+class HwBridgeStackSwap : public WithRunFolder<::testing::Test> {
  protected:
   HwBridgeStackSwap() : WithRunFolder("stewart_hw_swap_test") {}
 };
@@ -60,7 +52,7 @@ TEST_F(HwBridgeStackSwap, PaperScenarioAgainstTheEmulatorHoldsTheLimits) {
   const std::string output_path = run_folder_ + "/launch.out";
   WriteConfig(config_path);
   const auto start = std::chrono::steady_clock::now();
-  const int exit_code = test_support::RunLauncher(
+  const int exit_code = RunLauncher(
       "--no-build --plant hw --device-emulator --scenario paper --config " +
           ShellQuote(config_path) + " --duration " + FormatNumber(kDurationS) + " --no-report",
       kLcmPort, run_dir, output_path);
@@ -72,7 +64,7 @@ TEST_F(HwBridgeStackSwap, PaperScenarioAgainstTheEmulatorHoldsTheLimits) {
 
   const StackConfig config = LoadStackConfig(run_dir + "/config.yaml");
   ASSERT_EQ(config.hw_bridge.device_port, kDevicePort);
-  const RecordedRun s = test_support::ReadRecordedRun(run_dir + "/log.lcm", config);
+  const RecordedRun s = ReadRecordedRun(run_dir + "/log.lcm", config);
   const Bound* worst = s.Worst();
   ASSERT_NE(worst, nullptr);
   std::printf(
@@ -100,4 +92,4 @@ TEST_F(HwBridgeStackSwap, PaperScenarioAgainstTheEmulatorHoldsTheLimits) {
 }
 
 }  // namespace
-}  // namespace stewart
+}  // namespace stewart::test

@@ -26,14 +26,8 @@
 #include "stewart/config/config_loader.h"
 #include "stewart/test_support/stack_launch.h"
 
-namespace stewart {
+namespace stewart::test {
 namespace {
-
-using test_support::FormatNumber;
-using test_support::kLaunchTimeoutS;
-using test_support::ReadFile;
-using test_support::Shell;
-using test_support::ShellQuote;
 
 constexpr int kLcmPort = 7830;  // this folder's ports: 7830-7839
 constexpr double kDurationS = 4.0;
@@ -74,7 +68,7 @@ std::map<long long, std::vector<double>> ReadReplayedForces(const std::string& p
   return forces;
 }
 
-class ReplayStack : public test_support::WithRunFolder<::testing::Test> {
+class ReplayStack : public WithRunFolder<::testing::Test> {
  protected:
   ReplayStack() : WithRunFolder("stewart_replay_stack") {}
 
@@ -83,7 +77,6 @@ class ReplayStack : public test_support::WithRunFolder<::testing::Test> {
     return Shell(ShellQuote(STEWART_REPLAY_PATH) + " " + ShellQuote(run) + " " + args + " >" +
                  ShellQuote(run_folder_ + "/" + name + ".out") + " 2>&1");
   }
-
 };
 
 /// Messages of all channels lcm-logger lost.
@@ -106,9 +99,9 @@ TEST_F(ReplayStack, LockstepRunReplaysBitIdentically) {
   for (int attempt = 1; attempt <= kAttempts; ++attempt) {
     run = run_folder_ + "/run" + std::to_string(attempt);
     const std::string launch_out = run_folder_ + "/launch" + std::to_string(attempt) + ".out";
-    const int launch = test_support::RunLauncher(
-        "--no-build --scenario paper --duration " + FormatNumber(kDurationS), kLcmPort, run,
-        launch_out);
+    const int launch =
+        RunLauncher("--no-build --scenario paper --duration " + FormatNumber(kDurationS), kLcmPort,
+                    run, launch_out);
     ASSERT_EQ(launch, 0) << "tools/launch.sh failed (124: killed by the " << kLaunchTimeoutS
                          << " s guard); its output:\n"
                          << ReadFile(launch_out);
@@ -234,4 +227,4 @@ TEST_F(ReplayStack, LockstepRunReplaysBitIdentically) {
 }
 
 }  // namespace
-}  // namespace stewart
+}  // namespace stewart::test

@@ -23,16 +23,8 @@
 #include "stewart/test_support/recorded_run.h"
 #include "stewart/test_support/stack_launch.h"
 
-namespace stewart {
+namespace stewart::test {
 namespace {
-
-using test_support::Bound;
-using test_support::FormatNumber;
-using test_support::kLaunchTimeoutS;
-using test_support::kLimitTolerance;
-using test_support::ReadFile;
-using test_support::RecordedRun;
-using test_support::ShellQuote;
 
 struct StackCase {
   const char* scenario;
@@ -49,8 +41,7 @@ void PrintTo(const StackCase& c, std::ostream* os) {
   *os << c.scenario << " (" << c.duration_s << " s, LCM port " << c.lcm_port << ")";
 }
 
-class StackLockstep
-    : public test_support::WithRunFolder<::testing::TestWithParam<StackCase>> {
+class StackLockstep : public WithRunFolder<::testing::TestWithParam<StackCase>> {
  protected:
   StackLockstep() : WithRunFolder("stewart_stack_test") {}
 };
@@ -60,10 +51,9 @@ TEST_P(StackLockstep, LimitsHoldOnGroundTruth) {
   const std::string run_dir = run_folder_ + "/run";
   const std::string output_path = run_folder_ + "/launch.out";
   const auto start = std::chrono::steady_clock::now();
-  const int exit_code = test_support::RunLauncher(
-      "--scenario " + ShellQuote(c.scenario) + " --duration " + FormatNumber(c.duration_s) +
-          " --no-build --no-report",
-      c.lcm_port, run_dir, output_path);
+  const int exit_code = RunLauncher("--scenario " + ShellQuote(c.scenario) + " --duration " +
+                                        FormatNumber(c.duration_s) + " --no-build --no-report",
+                                    c.lcm_port, run_dir, output_path);
   const double wall_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   ASSERT_EQ(exit_code, 0) << "tools/launch.sh failed after " << wall_s << " s (124: killed by the "
@@ -74,7 +64,7 @@ TEST_P(StackLockstep, LimitsHoldOnGroundTruth) {
   const StackConfig config = LoadStackConfig(run_dir + "/config.yaml");
   ASSERT_FALSE(config.safety.position_limits.empty());
   ASSERT_FALSE(config.safety.velocity_limits.empty());
-  const RecordedRun s = test_support::ReadRecordedRun(run_dir + "/log.lcm", config);
+  const RecordedRun s = ReadRecordedRun(run_dir + "/log.lcm", config);
   const Bound* worst = s.Worst();
   ASSERT_NE(worst, nullptr);
   std::printf(
@@ -114,4 +104,4 @@ INSTANTIATE_TEST_SUITE_P(Scenarios, StackLockstep, ::testing::ValuesIn(kCases),
                          });
 
 }  // namespace
-}  // namespace stewart
+}  // namespace stewart::test

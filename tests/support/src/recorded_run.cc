@@ -9,7 +9,7 @@
 #include "stewart/model/types.h"
 #include "stewart/test_support/stack_launch.h"
 
-namespace stewart::test_support {
+namespace stewart::test {
 
 std::vector<Bound> BoundsOf(const SafetyConfig& safety) {
   std::vector<Bound> bounds;
@@ -93,4 +93,4 @@ RecordedRun ReadRecordedRun(const std::string& log_path, const StackConfig& conf
   return s;
 }
 
-}  // namespace stewart::test_support
+}  // namespace stewart::test

@@ -8,7 +8,7 @@
 
 #include "stewart/node/lcm_handle.h"
 
-namespace stewart::test_support {
+namespace stewart::test {
 
 std::string ShellQuote(const std::string& s) {
   std::string quoted = "'";
@@ -52,4 +52,4 @@ int RunLauncher(const std::string& args, int lcm_port, const std::string& run_di
                ShellQuote(PrivateLcmUrl(lcm_port)) + " >" + ShellQuote(output_path) + " 2>&1");
 }
 
-}  // namespace stewart::test_support
+}  // namespace stewart::test

@@ -10,7 +10,7 @@
 #include "stewart/config/config_loader.h"
 #include "stewart/state_t.hpp"
 
-namespace stewart::test_support {
+namespace stewart::test {
 
 /// How far ground truth may pass a limit: m and m/s, docs/safety.md "Tolerance".
 constexpr double kLimitTolerance = 1e-3;
@@ -53,4 +53,4 @@ struct RecordedRun {
 /// `config.safety`. An unreadable log reads as an empty run.
 RecordedRun ReadRecordedRun(const std::string& log_path, const StackConfig& config);
 
-}  // namespace stewart::test_support
+}  // namespace stewart::test

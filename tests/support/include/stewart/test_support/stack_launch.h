@@ -12,8 +12,9 @@
 #include <filesystem>
 #include <string>
 #include <system_error>
+#include <utility>
 
-namespace stewart::test_support {
+namespace stewart::test {
 
 /// Guard on each launcher run: SIGTERM after this, SIGKILL 30 s later.
 constexpr int kLaunchTimeoutS = 300;
@@ -68,4 +69,4 @@ class WithRunFolder : public Base {
   std::string prefix_;
 };
 
-}  // namespace stewart::test_support
+}  // namespace stewart::test
