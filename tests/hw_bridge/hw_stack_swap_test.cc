@@ -13,7 +13,6 @@
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
-#include <chrono>
 #include <cstdio>
 #include <fstream>
 #include <string>
@@ -51,16 +50,11 @@ TEST_F(HwBridgeStackSwap, PaperScenarioAgainstTheEmulatorHoldsTheLimits) {
   const std::string run_dir = run_folder_ + "/run";
   const std::string output_path = run_folder_ + "/launch.out";
   WriteConfig(config_path);
-  const auto start = std::chrono::steady_clock::now();
-  const int exit_code = RunLauncher(
+  const LaunchResult launch = RunLauncher(
       "--no-build --plant hw --device-emulator --scenario paper --config " +
           ShellQuote(config_path) + " --duration " + FormatNumber(kDurationS) + " --no-report",
       kLcmPort, run_dir, output_path);
-  const double wall_s =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  ASSERT_EQ(exit_code, 0) << "tools/launch.sh failed after " << wall_s << " s (124: killed by the "
-                          << kLaunchTimeoutS << " s guard); its output:\n"
-                          << ReadFile(output_path);
+  ASSERT_EQ(launch.exit_code, 0) << LaunchFailure(launch);
 
   const StackConfig config = LoadStackConfig(run_dir + "/config.yaml");
   ASSERT_EQ(config.hw_bridge.device_port, kDevicePort);
@@ -70,8 +64,8 @@ TEST_F(HwBridgeStackSwap, PaperScenarioAgainstTheEmulatorHoldsTheLimits) {
   std::printf(
       "[hw swap] paper, %g s against hw_emulator in %.1f s wall: %ld truth samples over %.2f s, "
       "max x %.5f m, max xd %.5f m/s, max excess %.2e (%s), %ld of %ld estimates diverged\n",
-      kDurationS, wall_s, s.truth_samples, s.truth_span_s, s.max_x, s.max_xd, worst->max_excess,
-      worst->name.c_str(), s.diverged_estimates, s.estimates);
+      kDurationS, launch.wall_s, s.truth_samples, s.truth_span_s, s.max_x, s.max_xd,
+      worst->max_excess, worst->name.c_str(), s.diverged_estimates, s.estimates);
 
   // The emulator published its ground truth over the whole run.
   EXPECT_EQ(s.truth_undecodable + s.estimates_undecodable, 0);

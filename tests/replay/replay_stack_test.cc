@@ -99,12 +99,10 @@ TEST_F(ReplayStack, LockstepRunReplaysBitIdentically) {
   for (int attempt = 1; attempt <= kAttempts; ++attempt) {
     run = run_folder_ + "/run" + std::to_string(attempt);
     const std::string launch_out = run_folder_ + "/launch" + std::to_string(attempt) + ".out";
-    const int launch =
+    const LaunchResult launch =
         RunLauncher("--no-build --scenario paper --duration " + FormatNumber(kDurationS), kLcmPort,
                     run, launch_out);
-    ASSERT_EQ(launch, 0) << "tools/launch.sh failed (124: killed by the " << kLaunchTimeoutS
-                         << " s guard); its output:\n"
-                         << ReadFile(launch_out);
+    ASSERT_EQ(launch.exit_code, 0) << LaunchFailure(launch);
 
     // The safety filter, the controller and the estimator as they ran.
     ASSERT_EQ(Replay(run,

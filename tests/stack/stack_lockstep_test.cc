@@ -13,7 +13,6 @@
 // path printed; after a pass it is removed.
 #include <gtest/gtest.h>
 
-#include <chrono>
 #include <cstdio>
 #include <ostream>
 #include <string>
@@ -50,15 +49,11 @@ TEST_P(StackLockstep, LimitsHoldOnGroundTruth) {
   const StackCase& c = GetParam();
   const std::string run_dir = run_folder_ + "/run";
   const std::string output_path = run_folder_ + "/launch.out";
-  const auto start = std::chrono::steady_clock::now();
-  const int exit_code = RunLauncher("--scenario " + ShellQuote(c.scenario) + " --duration " +
-                                        FormatNumber(c.duration_s) + " --no-build --no-report",
-                                    c.lcm_port, run_dir, output_path);
-  const double wall_s =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  ASSERT_EQ(exit_code, 0) << "tools/launch.sh failed after " << wall_s << " s (124: killed by the "
-                          << kLaunchTimeoutS << " s guard); its output:\n"
-                          << ReadFile(output_path);
+  const LaunchResult launch =
+      RunLauncher("--scenario " + ShellQuote(c.scenario) + " --duration " +
+                      FormatNumber(c.duration_s) + " --no-build --no-report",
+                  c.lcm_port, run_dir, output_path);
+  ASSERT_EQ(launch.exit_code, 0) << LaunchFailure(launch);
 
   // The limits the run used: the launcher keeps its config beside the log.
   const StackConfig config = LoadStackConfig(run_dir + "/config.yaml");
@@ -70,8 +65,8 @@ TEST_P(StackLockstep, LimitsHoldOnGroundTruth) {
   std::printf(
       "[stack] %s: %g s simulated, launcher %.1f s, %ld truth samples, max x %.5f m, "
       "max xd %.5f m/s, max excess %.2e (%s)\n",
-      c.scenario, c.duration_s, wall_s, s.truth_samples, s.max_x, s.max_xd, worst->max_excess,
-      worst->name.c_str());
+      c.scenario, c.duration_s, launch.wall_s, s.truth_samples, s.max_x, s.max_xd,
+      worst->max_excess, worst->name.c_str());
 
   // The run was meaningful: a whole recording, and the platform went where
   // the limits are.

@@ -31,15 +31,25 @@ std::string FormatNumber(double value);
 /// Exit code of a shell command (128 + signal if killed, -1 if it could not run).
 int Shell(const std::string& command);
 
+/// How a launcher run ended.
+struct LaunchResult {
+  int exit_code = -1;       ///< Shell()'s code (124: killed by the kLaunchTimeoutS guard)
+  double wall_s = 0.0;      ///< how long the launcher ran
+  std::string output_path;  ///< its stdout and stderr
+};
+
 /// Runs `tools/launch.sh <args> --out <run_dir> --lcm-url <private URL on lcm_port>`
 /// from the source folder on this build folder; its output goes to
 /// `output_path`. `args` must hold --no-build: ctest must not rebuild under
 /// itself. One launcher at a time per build folder (flock on
 /// <build>/stack_launch.lock), so parallel ctest runs do not share 2 cores
-/// four processes each; kLaunchTimeoutS guards it. Returns Shell()'s code
-/// (124: killed by the guard).
-int RunLauncher(const std::string& args, int lcm_port, const std::string& run_dir,
-                const std::string& output_path);
+/// four processes each; kLaunchTimeoutS guards it.
+LaunchResult RunLauncher(const std::string& args, int lcm_port, const std::string& run_dir,
+                         const std::string& output_path);
+
+/// Why a launch failed, for the test's message: the exit code's meaning, the
+/// wall time and the launcher's whole output.
+std::string LaunchFailure(const LaunchResult& launch);
 
 /// A test fixture with a fresh folder /tmp/<prefix>_XXXXXX (run_folder_) for
 /// the run: removed after a pass, kept and its path printed after a failure.
