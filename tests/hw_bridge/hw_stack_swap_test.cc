@@ -1,6 +1,6 @@
 // The plant swap end to end: tools/launch.sh --plant hw
 // --device-emulator starts the real stack (estimator, controller, safety,
-// lcm-logger) on hw_bridge talking UDP to hw_emulator, in real time, on a
+// stewart_logger) on hw_bridge talking UDP to hw_emulator, in real time, on a
 // private LCM URL and private device ports. A short stretch of the paper
 // scenario; on the emulator's ground truth (STATE_TRUE, published for
 // evaluation only) every configured position and velocity limit must hold

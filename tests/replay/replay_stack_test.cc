@@ -1,5 +1,5 @@
 // stewart_replay on a real run: tools/launch.sh runs the LCM stack (plant_sim
-// in lockstep, estimator, controller, safety, lcm-logger) on the paper
+// in lockstep, estimator, controller, safety, stewart_logger) on the paper
 // scenario for 4 s on a private URL and writes the report; then, on the
 // recorded inputs:
 //   - the closed-form replay of the safety filter is bit-identical to every

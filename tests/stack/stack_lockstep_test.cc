@@ -1,6 +1,6 @@
 // The real stack over LCM, as tools/launch.sh starts it: plant_sim in
 // lockstep, estimator, controller and safety as separate processes, recorded
-// by lcm-logger, on a private URL. A short stretch of each scenario; every
+// by stewart_logger, on a private URL. A short stretch of each scenario; every
 // configured position and velocity limit must hold on the recorded ground
 // truth (STATE_TRUE) within the tolerance docs/safety.md states (1 mm,
 // 1 mm/s), and the run must have challenged the limits.
