@@ -4,7 +4,8 @@ namespace stewart {
 
 PlantSimConfig ParsePlantSimConfig(const ConfigNode& plant_sim) {
   PlantSimConfig p;
-  // Optional, so configs written before the key existed keep loading.
+  // Optional: a run's config.yaml without the key (which the replay loads)
+  // keeps loading.
   if (plant_sim.Has("integrator")) {
     p.integrator = plant_sim.Choice("integrator", {"arkode_erk", "cvode_bdf", "cvode_adams"});
   }

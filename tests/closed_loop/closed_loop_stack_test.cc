@@ -8,10 +8,10 @@
 
 #include <string>
 
-#include "stewart/config/scenario_loader.h"
-#include "stewart/stack/closed_loop.h"
 #include "stewart/config/config_loader.h"
+#include "stewart/config/scenario_loader.h"
 #include "stewart/controller/scenario.h"
+#include "stewart/stack/closed_loop.h"
 
 namespace stewart {
 namespace {
@@ -45,7 +45,7 @@ TEST_P(ScenarioLimits, HoldOnGroundTruthWithTheEkfForSeveralSeeds) {
         << FormatSummary(Config(), s);
     EXPECT_EQ(s.infeasible_ticks, 0);
     EXPECT_EQ(s.estimator_reinits, 0);
-    // The estimator's accuracy in the loop (issue bounds, docs/estimator.md):
+    // The estimator's accuracy in the loop (the bounds of docs/estimator.md):
     // translations 0.5 mm, translational rates 2 mm/s (measured ~0.03 mm, 0.4 mm/s).
     EXPECT_LT(s.rms_q_error, 0.5e-3);
     EXPECT_LT(s.rms_qd_error, 2e-3);

@@ -1,5 +1,5 @@
 // stewart_replay on a real run: tools/launch.sh runs the LCM stack (plant_sim
-// in lockstep, estimator, controller, safety, lcm-logger) on the paper
+// in lockstep, estimator, controller, safety, stewart_logger) on the paper
 // scenario for 4 s on a private URL and writes the report; then, on the
 // recorded inputs:
 //   - the closed-form replay of the safety filter is bit-identical to every
@@ -12,15 +12,10 @@
 //
 // On a failure the temporary run folder is kept and its path printed.
 #include <gtest/gtest.h>
-#include <stdlib.h>
-#include <sys/wait.h>
 
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
-#include <filesystem>
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -29,42 +24,16 @@
 #include <vector>
 
 #include "stewart/config/config_loader.h"
+#include "stewart/test_support/stack_launch.h"
 
-namespace stewart {
+namespace stewart::test {
 namespace {
 
 constexpr int kLcmPort = 7830;  // this folder's ports: 7830-7839
 constexpr double kDurationS = 4.0;
-constexpr int kLaunchTimeoutS = 300;
 constexpr long kMinCompared = 3500;
 constexpr int kAttempts = 3;            // stack runs until lcm-logger records every message
-constexpr double kQpToleranceN = 1e-6;  // the acceptance bound
-std::string ShellQuote(const std::string& s) {
-  std::string quoted = "'";
-  for (char ch : s) {
-    if (ch == '\'') {
-      quoted += "'\\''";
-    } else {
-      quoted += ch;
-    }
-  }
-  return quoted + "'";
-}
-
-std::string ReadFile(const std::string& path) {
-  std::ifstream in(path);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
-/// Exit code of a shell command (128 + signal if killed, -1 if it could not run).
-int Shell(const std::string& command) {
-  const int status = std::system(command.c_str());
-  if (status == -1) return -1;
-  if (WIFEXITED(status)) return WEXITSTATUS(status);
-  return WIFSIGNALED(status) ? 128 + WTERMSIG(status) : -1;
-}
+constexpr double kQpToleranceN = 1e-6;  // closed form vs QP reference on the same inputs
 
 /// Messages of `channel` lcm-logger lost (seq gaps), from stewart_replay's JSON.
 long Missing(const nlohmann::json& replay, const std::string& channel) {
@@ -99,29 +68,15 @@ std::map<long long, std::vector<double>> ReadReplayedForces(const std::string& p
   return forces;
 }
 
-class ReplayStack : public ::testing::Test {
+class ReplayStack : public WithRunFolder<::testing::Test> {
  protected:
-  void SetUp() override {
-    char dir[] = "/tmp/stewart_replay_stack_XXXXXX";
-    ASSERT_NE(mkdtemp(dir), nullptr) << std::strerror(errno);
-    root_ = dir;
-  }
-  void TearDown() override {
-    if (HasFailure()) {
-      std::printf("run folder kept: %s\n", root_.c_str());
-      return;
-    }
-    std::error_code ignored;
-    std::filesystem::remove_all(root_, ignored);
-  }
+  ReplayStack() : WithRunFolder("stewart_replay_stack") {}
 
   /// stewart_replay on the run; its stdout and stderr go to <root>/<name>.out.
   int Replay(const std::string& run, const std::string& args, const std::string& name) {
     return Shell(ShellQuote(STEWART_REPLAY_PATH) + " " + ShellQuote(run) + " " + args + " >" +
-                 ShellQuote(root_ + "/" + name + ".out") + " 2>&1");
+                 ShellQuote(run_folder_ + "/" + name + ".out") + " 2>&1");
   }
-
-  std::string root_;
 };
 
 /// Messages of all channels lcm-logger lost.
@@ -132,11 +87,8 @@ long TotalMissing(const nlohmann::json& replay) {
 }
 
 TEST_F(ReplayStack, LockstepRunReplaysBitIdentically) {
-  const std::string url = "udpm://239.255.76.67:" + std::to_string(kLcmPort) + "?ttl=0";
-  char duration[16];
-  std::snprintf(duration, sizeof duration, "%g", kDurationS);
-  const std::string cf_json = root_ + "/closed_form.json";
-  const std::string cf_csv = root_ + "/closed_form.csv";
+  const std::string cf_json = run_folder_ + "/closed_form.json";
+  const std::string cf_csv = run_folder_ + "/closed_form.csv";
   // lcm-logger drops bursts silently when it is descheduled (see the
   // estimator below); the live stack does not. A log with gaps still replays
   // exactly where it has the messages, but lacks some of them: the stack is
@@ -145,18 +97,12 @@ TEST_F(ReplayStack, LockstepRunReplaysBitIdentically) {
   std::string run;
   nlohmann::json cf;
   for (int attempt = 1; attempt <= kAttempts; ++attempt) {
-    run = root_ + "/run" + std::to_string(attempt);
-    const std::string launch_out = root_ + "/launch" + std::to_string(attempt) + ".out";
-    const int launch = Shell("cd " + ShellQuote(STEWART_SOURCE_DIR) +
-                             " && STEWART_BUILD_DIR=" + ShellQuote(STEWART_BUILD_DIR) + " flock " +
-                             ShellQuote(std::string(STEWART_BUILD_DIR) + "/stack_launch.lock") +
-                             " timeout -k 30 " + std::to_string(kLaunchTimeoutS) +
-                             " tools/launch.sh --no-build --scenario paper --duration " + duration +
-                             " --out " + ShellQuote(run) + " --lcm-url " + ShellQuote(url) + " >" +
-                             ShellQuote(launch_out) + " 2>&1");
-    ASSERT_EQ(launch, 0) << "tools/launch.sh failed (124: killed by the " << kLaunchTimeoutS
-                         << " s guard); its output:\n"
-                         << ReadFile(launch_out);
+    run = run_folder_ + "/run" + std::to_string(attempt);
+    const std::string launch_out = run_folder_ + "/launch" + std::to_string(attempt) + ".out";
+    const LaunchResult launch =
+        RunLauncher("--no-build --scenario paper --duration " + FormatNumber(kDurationS), kLcmPort,
+                    run, launch_out);
+    ASSERT_EQ(launch.exit_code, 0) << LaunchFailure(launch);
 
     // The safety filter, the controller and the estimator as they ran.
     ASSERT_EQ(Replay(run,
@@ -164,13 +110,13 @@ TEST_F(ReplayStack, LockstepRunReplaysBitIdentically) {
                          ShellQuote(cf_json) + " --csv " + ShellQuote(cf_csv),
                      "closed_form"),
               0)
-        << ReadFile(root_ + "/closed_form.out");
+        << ReadFile(run_folder_ + "/closed_form.out");
     cf = nlohmann::json::parse(ReadFile(cf_json));
     if (TotalMissing(cf) == 0) break;
     std::printf("[replay] attempt %d: lcm-logger lost %ld messages: %s\n", attempt,
                 TotalMissing(cf), cf["log_gaps"].dump().c_str());
   }
-  std::printf("%s", ReadFile(root_ + "/closed_form.out").c_str());
+  std::printf("%s", ReadFile(run_folder_ + "/closed_form.out").c_str());
   const ChannelNames channels = LoadStackConfig(run + "/config.yaml").lcm.channels;
   const long missing_estimates = Missing(cf, channels.state_estimate);
   // Nominal commands (or their safe commands) the log lacks cannot be compared.
@@ -239,13 +185,13 @@ TEST_F(ReplayStack, LockstepRunReplaysBitIdentically) {
   EXPECT_LE(e.at("recorded_without_replay").get<long>(), missing_inputs);
 
   // The QP reference on the same inputs: the same forces within 1e-6 N.
-  const std::string qp_json = root_ + "/qp.json";
-  const std::string qp_csv = root_ + "/qp.csv";
+  const std::string qp_json = run_folder_ + "/qp.json";
+  const std::string qp_csv = run_folder_ + "/qp.csv";
   const int qp_exit = Replay(run,
                              "--variant qp --expect-identical --json " + ShellQuote(qp_json) +
                                  " --csv " + ShellQuote(qp_csv),
                              "qp");
-  ASSERT_TRUE(qp_exit == 0 || qp_exit == 1) << ReadFile(root_ + "/qp.out");
+  ASSERT_TRUE(qp_exit == 0 || qp_exit == 1) << ReadFile(run_folder_ + "/qp.out");
   const nlohmann::json qp = nlohmann::json::parse(ReadFile(qp_json));
   EXPECT_EQ(qp_exit, qp.at("differing").get<long>() > 0 ? 1 : 0);
   EXPECT_EQ(qp.at("safety").at("variant"), "qp");
@@ -279,4 +225,4 @@ TEST_F(ReplayStack, LockstepRunReplaysBitIdentically) {
 }
 
 }  // namespace
-}  // namespace stewart
+}  // namespace stewart::test

@@ -3,9 +3,9 @@
 // and stewart_replay read it).
 //
 // Why not lcm-logger: 1.3.1 subscribes with LCM's default 30-message queue
-// and silently drops bursts whenever it is descheduled (measured on 2 cores:
-// 0-861 messages per 4 s lockstep run, 6 % of one 40 s run), and like every
-// lcm::LCM receiver it is woken twice per message. This one reads the
+// and silently drops bursts whenever it is descheduled (docs/operations.md,
+// "Logging"), and like every lcm::LCM receiver it is woken twice per
+// message. This one reads the
 // socket itself (stewart::LcmReceiver) in batches: it sleeps --batch-ms
 // between reads and takes everything the kernel queued meanwhile (the socket
 // buffer, recv_buf_size on the URL, holds seconds of the stack's traffic),

@@ -102,7 +102,7 @@ def replay_section(run):
     lines += [f"- max |F_closed_form - F_qp| over every step: **{max_diff:.3g} N**"
               + (f" (at sample_utime {worst} us)" if worst is not None and max_diff > 0 else "")]
     verdict = "met" if max_diff < 1e-6 else "NOT met"
-    lines += [f"- issue acceptance (same forces, max difference below 1e-6 N): {verdict} "
+    lines += [f"- target (same forces, max difference below 1e-6 N): {verdict} "
               f"(measured {max_diff:.3g} N)", ""]
     lines += ["| filter | p50 | p99 | steps |", "| --- | --- | --- | --- |"]
     t_cf, t_qp = cf_s["compute_ns"]["replayed"], qp_s["compute_ns"]["replayed"]

@@ -5,13 +5,12 @@
 // force map H (InverseDynamics, the filter's F* when a constraint acts).
 //
 // Why not Eigen's LLT / PartialPivLU: at 6x6 both run their generic
-// (runtime-sized, blocked) kernels. On the bench machine a factor of M and
-// two solves took ~220 ns with LLT and take ~60 ns here; a solve with H
-// ~175 ns with PartialPivLU, ~80 ns here (docs/performance.md). The loops
-// below have compile-time bounds and are unrolled; they are the textbook
-// algorithms (square-root-free Cholesky L D L^T, one division and no square
-// root per column; Gaussian elimination with partial pivoting), so the
-// accuracy is Eigen's (tests/model/linear_algebra6_test.cc).
+// (runtime-sized, blocked) kernels, which cost a few times more than these
+// (figures in docs/performance.md). The loops below have compile-time bounds
+// and are unrolled; they are the textbook algorithms (square-root-free
+// Cholesky L D L^T, one division and no square root per column; Gaussian
+// elimination with partial pivoting), so the accuracy is Eigen's
+// (tests/model/linear_algebra6_test.cc).
 #include <cmath>
 #include <utility>
 

@@ -10,8 +10,7 @@
 namespace stewart {
 
 /// sin and cos of r = [phi theta psi], computed once: R, E and Edot rd all
-/// need them, and the sincos calls were a measurable part of a model
-/// evaluation when each function computed its own.
+/// need them, and sincos is a noticeable part of a model evaluation.
 struct EulerAngleTrig {
   explicit EulerAngleTrig(const Vector3d& rpy_rad);
   double sin_phi, cos_phi, sin_theta, cos_theta, sin_psi, cos_psi;

@@ -4,11 +4,10 @@
 //
 // Why not lcm::LCM::subscribe: LCM 1.3.1 reads its socket in a thread of its
 // own and hands each message to the caller's thread through a pipe, so every
-// message costs two wake-ups. On the reference machine (2 vCPUs, where a
-// wake-up costs tens of microseconds) one hop of the control loop (publish
-// -> receive in another process) is 2.5-4x slower with lcm::LCM than with
-// one socket read in the receiving thread (stewart_lcm_hop_bench,
-// docs/performance.md, "LCM hop"), and a control tick crosses four hops.
+// message costs two wake-ups. On a small machine the wake-ups dominate one
+// hop of the control loop (publish -> receive in another process), and a
+// control tick crosses four hops; one socket read in the receiving thread
+// costs one (stewart_lcm_hop_bench, docs/performance.md, "LCM hop").
 //
 // What stays LCM: the wire format (LCM UDP multicast protocol: short "LC02"
 // and fragmented "LC03" datagrams), the URL, the multicast group and port,

@@ -1,0 +1,82 @@
+// Starting the LCM stack from a test: tools/launch.sh on the build folder the
+// test was built in, on a private LCM URL, in a temporary run folder that is
+// kept when the test fails.
+#pragma once
+
+#include <gtest/gtest.h>
+#include <stdlib.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <string>
+#include <system_error>
+#include <utility>
+
+namespace stewart::test {
+
+/// Guard on each launcher run: SIGTERM after this, SIGKILL 30 s later.
+constexpr int kLaunchTimeoutS = 300;
+
+/// `s` as one single-quoted shell word.
+std::string ShellQuote(const std::string& s);
+
+/// The whole file; empty if it cannot be read.
+std::string ReadFile(const std::string& path);
+
+/// `value` as printf's %g writes it.
+std::string FormatNumber(double value);
+
+/// Exit code of a shell command (128 + signal if killed, -1 if it could not run).
+int Shell(const std::string& command);
+
+/// How a launcher run ended.
+struct LaunchResult {
+  int exit_code = -1;       ///< Shell()'s code (124: killed by the kLaunchTimeoutS guard)
+  double wall_s = 0.0;      ///< how long the launcher ran
+  std::string output_path;  ///< its stdout and stderr
+};
+
+/// Runs `tools/launch.sh <args> --out <run_dir> --lcm-url <private URL on lcm_port>`
+/// from the source folder on this build folder; its output goes to
+/// `output_path`. `args` must hold --no-build: ctest must not rebuild under
+/// itself. One launcher at a time per build folder (flock on
+/// <build>/stack_launch.lock), so parallel ctest runs do not share 2 cores
+/// four processes each; kLaunchTimeoutS guards it.
+LaunchResult RunLauncher(const std::string& args, int lcm_port, const std::string& run_dir,
+                         const std::string& output_path);
+
+/// Why a launch failed, for the test's message: the exit code's meaning, the
+/// wall time and the launcher's whole output.
+std::string LaunchFailure(const LaunchResult& launch);
+
+/// A test fixture with a fresh folder /tmp/<prefix>_XXXXXX (run_folder_) for
+/// the run: removed after a pass, kept and its path printed after a failure.
+template <class Base>
+class WithRunFolder : public Base {
+ protected:
+  explicit WithRunFolder(std::string prefix) : prefix_(std::move(prefix)) {}
+
+  void SetUp() override {
+    std::string pattern = "/tmp/" + prefix_ + "_XXXXXX";
+    ASSERT_NE(mkdtemp(pattern.data()), nullptr) << std::strerror(errno);
+    run_folder_ = pattern;
+  }
+  void TearDown() override {
+    if (run_folder_.empty()) return;
+    if (::testing::Test::HasFailure()) {
+      std::printf("run folder kept: %s\n", run_folder_.c_str());
+      return;
+    }
+    std::error_code ignored;
+    std::filesystem::remove_all(run_folder_, ignored);
+  }
+
+  std::string run_folder_;
+
+ private:
+  std::string prefix_;
+};
+
+}  // namespace stewart::test

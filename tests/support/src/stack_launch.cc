@@ -1,0 +1,70 @@
+#include "stewart/test_support/stack_launch.h"
+
+#include <sys/wait.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+
+#include "stewart/node/lcm_handle.h"
+
+namespace stewart::test {
+
+std::string ShellQuote(const std::string& s) {
+  std::string quoted = "'";
+  for (char ch : s) {
+    if (ch == '\'') {
+      quoted += "'\\''";
+    } else {
+      quoted += ch;
+    }
+  }
+  return quoted + "'";
+}
+
+std::string ReadFile(const std::string& path) {
+  std::ifstream in(path);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+std::string FormatNumber(double value) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", value);
+  return text;
+}
+
+int Shell(const std::string& command) {
+  const int status = std::system(command.c_str());
+  if (status == -1) return -1;
+  if (WIFEXITED(status)) return WEXITSTATUS(status);
+  return WIFSIGNALED(status) ? 128 + WTERMSIG(status) : -1;
+}
+
+LaunchResult RunLauncher(const std::string& args, int lcm_port, const std::string& run_dir,
+                         const std::string& output_path) {
+  LaunchResult launch;
+  launch.output_path = output_path;
+  const auto start = std::chrono::steady_clock::now();
+  launch.exit_code =
+      Shell("cd " + ShellQuote(STEWART_SOURCE_DIR) +
+            " && STEWART_BUILD_DIR=" + ShellQuote(STEWART_BUILD_DIR) + " flock " +
+            ShellQuote(std::string(STEWART_BUILD_DIR) + "/stack_launch.lock") + " timeout -k 30 " +
+            std::to_string(kLaunchTimeoutS) + " tools/launch.sh " + args + " --out " +
+            ShellQuote(run_dir) + " --lcm-url " + ShellQuote(PrivateLcmUrl(lcm_port)) + " >" +
+            ShellQuote(output_path) + " 2>&1");
+  launch.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return launch;
+}
+
+std::string LaunchFailure(const LaunchResult& launch) {
+  std::ostringstream text;
+  text << "tools/launch.sh failed after " << launch.wall_s << " s (124: killed by the "
+       << kLaunchTimeoutS << " s guard); its output:\n"
+       << ReadFile(launch.output_path);
+  return text.str();
+}
+
+}  // namespace stewart::test
