@@ -7,7 +7,6 @@
 #include <memory>
 
 #include "stewart/common/check.h"
-#include "stewart/config/config_loader.h"
 #include "stewart/node/lcm_handle.h"
 #include "stewart/node/node_options.h"
 #include "stewart/node/stop_signal.h"

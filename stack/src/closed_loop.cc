@@ -1,25 +1,21 @@
 #include "stewart/stack/closed_loop.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
 
-#include "stewart/controller/controller.h"
-#include "stewart/estimator/ekf.h"
+#include "stewart/common/health_counters.h"
+#include "stewart/common/signals.h"
+#include "stewart/controller/controller_process.h"
+#include "stewart/estimator/estimator_process.h"
+#include "stewart/plant_sim/ode_integrator.h"
 #include "stewart/plant_sim/plant.h"
 #include "stewart/plant_sim/sensor_model.h"
-#include "stewart/safety/safety_filter.h"
+#include "stewart/safety/safety_process.h"
 
 namespace stewart {
 namespace {
-
-OdeOptions OdeOptionsOf(const PlantSimConfig& c) {
-  OdeOptions o;
-  o.method = ParseOdeMethod(c.integrator);
-  o.rel_tol = c.rel_tol;
-  o.abs_tol = c.abs_tol;
-  return o;
-}
 
 void TrackLimitExcess(const SafetyConfig& s, const Vector6d& q, const Vector6d& qd,
                       ClosedLoopSummary* out) {
@@ -55,12 +51,19 @@ ClosedLoopSummary RunClosedLoop(const StackConfig& config, const Scenario& scena
                                 const ClosedLoopOptions& options, std::ostream* csv) {
   SensorConfig sensors = config.sensors;
   sensors.seed = static_cast<unsigned>(options.seed);
-  Plant plant(PlantModel{config.platform, config.actuators}, OdeOptionsOf(config.plant_sim));
+  Plant plant(PlantModel{config.platform, config.actuators}, OdeOptionsFrom(config.plant_sim));
   plant.Reset(0.0, config.plant_sim.initial_pose, config.plant_sim.initial_velocity);
   SensorModel sensor_model(sensors, config.actuators, config.platform.gravity_mps2);
-  Ekf ekf(config.platform, config.actuators, sensors, config.estimator, config.home_pose);
-  Controller controller(config.platform, config.controller, config.home_pose, scenario);
-  safety::SafetyFilter filter(config.platform, config.safety, config.actuators, options.reference);
+  // The processes' own classes, stepped in the order lockstep runs them:
+  // sample -> estimator -> controller -> safety -> plant.
+  HealthCounters estimator_counters("estimator"), controller_counters("controller"),
+      safety_counters("safety");
+  EstimatorProcess estimator(config.platform, config.actuators, sensors, config.estimator,
+                             config.home_pose, &estimator_counters);
+  ControllerProcess controller(config.platform, config.controller, config.home_pose, scenario,
+                               &controller_counters);
+  safety::SafetyProcess safety(config.platform, config.safety, config.actuators, options.reference,
+                               &safety_counters);
 
   const std::int64_t period_us = std::llround(1e6 / sensors.rate_hz);
   const long ticks = std::lround(options.duration_s * 1e6 / static_cast<double>(period_us));
@@ -77,15 +80,24 @@ ClosedLoopSummary RunClosedLoop(const StackConfig& config, const Scenario& scena
       for (int i = 1; i <= 6; ++i) *csv << ',' << prefix << i;
     *csv << ",case,h_pos,h_vel\n";
   }
+  Vector6d f_safe = Vector6d::Zero();  // held by the plant until the next command
   for (long k = 0; k < ticks; ++k) {
     const std::int64_t utime = k * period_us;
     const Vector6d q_true = plant.q(), qd_true = plant.qd();
     const PlantRates& rates = plant.EvaluateRates();
     const SensorReading r =
         sensor_model.Sample(q_true, qd_true, rates.x_dot.segment<6>(6), rates.terms.leg_length_m);
-    Vector6d q = q_true, qd = qd_true;
-    bool state_trusted = true;  // as the safety process: only STATUS_VALID states are filtered
-    if (!options.perfect_state) {
+    StateSample state;
+    bool has_state = false;
+    if (options.perfect_state) {
+      StateSample truth;
+      truth.utime = truth.sample_utime = utime;
+      truth.seq = k;
+      truth.q = q_true;
+      truth.qd = qd_true;
+      truth.status = kStateValid | kStateGroundTruth;
+      has_state = estimator.OnTruth(truth, &state);
+    } else {
       SensorSample sample;
       sample.utime = utime;
       sample.leg_length_m = r.leg_length_m;
@@ -93,50 +105,67 @@ ClosedLoopSummary RunClosedLoop(const StackConfig& config, const Scenario& scena
       sample.accel_mps2 = r.accel_mps2;
       sample.has_orientation = r.has_orientation;
       sample.orientation_rpy_rad = r.orientation_rpy_rad;
-      const UpdateResult u = ekf.Update(sample);
-      if (u.Has(kEventInitialized) && k > 0) ++out.estimator_reinits;
-      if (!u.has_estimate) {
-        plant.Advance(static_cast<double>(period_us) * 1e-6);
-        continue;
+      has_state = estimator.OnSensor(sample, &state);
+      if (has_state) {
+        sq_q += (state.q - q_true).head<3>().squaredNorm();
+        sq_qd += (state.qd - qd_true).head<3>().squaredNorm();
+        ++estimated_ticks;
       }
-      const Estimate e = ekf.estimate();
-      q = e.q;
-      qd = e.qd;
-      state_trusted = !e.initializing && !e.diverged;
-      sq_q += (q - q_true).head<3>().squaredNorm();
-      sq_qd += (qd - qd_true).head<3>().squaredNorm();
-      ++estimated_ticks;
     }
-    ControllerOutput c;
-    Vector6d f_safe = Vector6d::Zero();
-    safety::SafetyDiagnostics d;
-    if (controller.Step(utime, q, qd, &c) == StepStatus::kOk && state_trusted) {
-      f_safe = options.no_filter ? c.force_n : filter.Step(q, qd, c.force_n, &d);
+    if (!has_state) {
+      plant.Advance(static_cast<double>(period_us) * 1e-6);
+      continue;
+    }
+    ControllerProcessOutput nominal;
+    const bool has_nominal =
+        controller.OnState(state, &nominal) == ControllerVerdict::kPublished;
+    // Safety sees the state first, then the nominal command derived from it
+    // (always delivered: it shows the controller is alive). The plant, as in
+    // lockstep, applies the first command that answers this sample.
+    safety::SafetyOutput from_state, from_nominal;
+    const bool state_answered = safety.OnState(state, &from_state);
+    const bool nominal_answered = has_nominal && safety.OnNominal(nominal.command, &from_nominal);
+    const bool has_safe = state_answered || nominal_answered;
+    const safety::SafetyOutput& safe = state_answered ? from_state : from_nominal;
+    const bool filtered = has_safe && has_nominal && safe.fallback_reason == 0;
+    if (filtered) {
+      f_safe = options.no_filter ? nominal.command.force_n : safe.command.force_n;
       ++out.filtered_ticks;
-      out.sum_correction_n += (f_safe - c.force_n).norm();
-      if ((f_safe - c.force_n).norm() > 0.0) ++out.active_ticks;
+      const double correction = (f_safe - nominal.command.force_n).norm();
+      out.sum_correction_n += correction;
+      if (correction > 0.0) ++out.active_ticks;
+      const Setpoint& setpoint = nominal.setpoint_echo.setpoint;
       for (int a = 0; a < 6; ++a) {
-        if (!SetpointInside(config.safety, a, c.setpoint.q_des(a))) continue;
+        if (!SetpointInside(config.safety, a, setpoint.q_des(a))) continue;
         ++out.inside_ticks[static_cast<size_t>(a)];
-        const double e = q_true(a) - c.setpoint.q_des(a);
+        const double e = q_true(a) - setpoint.q_des(a);
         sq_tracking(a) += e * e;
       }
-    } else {
-      f_safe = filter.SafeStopCommand(q, qd, &d);
+    } else if (has_safe) {
+      f_safe = safe.command.force_n;
     }
-    ++out.case_ticks[static_cast<int>(d.filter_case)];
-    if (d.infeasible) ++out.infeasible_ticks;
+    const safety::SafetyDiagnostics* d = has_safe ? safe.diagnostics : nullptr;
+    if (d != nullptr) {
+      ++out.case_ticks[static_cast<size_t>(d->filter_case)];
+      if (d->infeasible) ++out.infeasible_ticks;
+    }
     const double f_max = f_safe.cwiseAbs().maxCoeff();
     out.max_force_n = std::max(out.max_force_n, f_max);
     if (f_max > config.actuators.force_limit_n) ++out.saturated_ticks;
-    if (!options.perfect_state) ekf.SetForceCommand(utime, f_safe);
+    if (has_safe) {
+      ForceCommand applied = safe.command;
+      applied.force_n = f_safe;
+      estimator.OnCommand(applied);
+    }
     if (csv) {
       *csv << static_cast<double>(utime) * 1e-6;
-      const std::array<const Vector6d*, 6> columns{&q_true, &qd_true, &q, &qd, &c.force_n, &f_safe};
+      const std::array<const Vector6d*, 6> columns{&q_true,  &qd_true,
+                                                   &state.q, &state.qd,
+                                                   &nominal.command.force_n, &f_safe};
       for (const Vector6d* v : columns)
         for (int i = 0; i < 6; ++i) *csv << ',' << (*v)(i);
-      *csv << ',' << static_cast<int>(d.filter_case) << ',' << d.barriers.h_pos << ','
-           << d.barriers.h_vel << '\n';
+      *csv << ',' << (d ? static_cast<int>(d->filter_case) : -1) << ','
+           << (d ? d->barriers.h_pos : 0.0) << ',' << (d ? d->barriers.h_vel : 0.0) << '\n';
     }
     plant.SetForceCommand(f_safe);
     plant.Advance(static_cast<double>(period_us) * 1e-6);
@@ -150,6 +179,9 @@ ClosedLoopSummary RunClosedLoop(const StackConfig& config, const Scenario& scena
     if (!q1.allFinite() || !qd1.allFinite()) return out;
   }
   out.q_final = plant.q();
+  // The first initialisation is the start, not a restart.
+  out.estimator_reinits =
+      std::max<long>(0, static_cast<long>(estimator_counters.counter("initialized")) - 1);
   if (estimated_ticks > 0) {
     out.rms_q_error = std::sqrt(sq_q / static_cast<double>(estimated_ticks));
     out.rms_qd_error = std::sqrt(sq_qd / static_cast<double>(estimated_ticks));
