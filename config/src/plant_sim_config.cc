@@ -1,4 +1,5 @@
 #include "stewart/config/sections.h"
+#include "stewart/plant_sim/ode_integrator.h"
 
 namespace stewart {
 
@@ -7,7 +8,7 @@ PlantSimConfig ParsePlantSimConfig(const ConfigNode& plant_sim) {
   // Optional: a run's config.yaml without the key (which the replay loads)
   // keeps loading.
   if (plant_sim.Has("integrator")) {
-    p.integrator = plant_sim.Choice("integrator", {"arkode_erk", "cvode_bdf", "cvode_adams"});
+    p.integrator = plant_sim.Choice("integrator", kOdeMethodNames.NameList());
   }
   p.rel_tol = plant_sim.PositiveDouble("rel_tol");
   p.abs_tol = plant_sim.PositiveDouble("abs_tol");

@@ -4,32 +4,6 @@
 
 namespace stewart {
 
-const char* ToString(SetpointStatus status) {
-  switch (status) {
-    case SetpointStatus::kAccepted:
-      return "accepted";
-    case SetpointStatus::kNonFinite:
-      return "setpoint_non_finite";
-    case SetpointStatus::kOutsideWorkspace:
-      return "setpoint_outside_workspace";
-  }
-  return "?";
-}
-
-const char* ToString(StepStatus status) {
-  switch (status) {
-    case StepStatus::kOk:
-      return "ok";
-    case StepStatus::kNonFiniteState:
-      return "state_non_finite";
-    case StepStatus::kTimeNotIncreasing:
-      return "state_time_not_increasing";
-    case StepStatus::kNonFiniteForce:
-      return "force_non_finite";
-  }
-  return "?";
-}
-
 Controller::Controller(const PlatformParams& platform, const ControllerConfig& gains,
                        const Vector6d& home_pose, std::optional<Scenario> scenario)
     : platform_(platform),

@@ -8,34 +8,6 @@ namespace {
 constexpr int32_t kSensorStatusMask = 0x1F;  // DeviceStatus bits 0..4 = sensor_t.STATUS_*
 }
 
-const char* ToString(DriveReason reason) {
-  switch (reason) {
-    case DriveReason::kCommand:
-      return "command";
-    case DriveReason::kMissing:
-      return "missing";
-    case DriveReason::kStale:
-      return "stale";
-    case DriveReason::kInvalid:
-      return "invalid";
-  }
-  return "unknown";
-}
-
-const char* ToString(CommandVerdict verdict) {
-  switch (verdict) {
-    case CommandVerdict::kAccepted:
-      return "accepted";
-    case CommandVerdict::kNonFinite:
-      return "non_finite_command";
-    case CommandVerdict::kOutOfOrder:
-      return "out_of_order_command";
-    case CommandVerdict::kFuture:
-      return "future_command";
-  }
-  return "unknown";
-}
-
 bool SendsAtOnce(CommandVerdict verdict) {
   return verdict == CommandVerdict::kAccepted || verdict == CommandVerdict::kNonFinite;
 }

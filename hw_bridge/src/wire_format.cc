@@ -82,28 +82,6 @@ void WriteHeader(Writer* w, FrameType type, std::size_t payload, uint32_t seq) {
 
 }  // namespace
 
-const char* ToString(DecodeStatus status) {
-  switch (status) {
-    case DecodeStatus::kOk:
-      return "ok";
-    case DecodeStatus::kNeedMore:
-      return "truncated";
-    case DecodeStatus::kBadSync:
-      return "bad_sync";
-    case DecodeStatus::kBadVersion:
-      return "bad_version";
-    case DecodeStatus::kBadType:
-      return "bad_type";
-    case DecodeStatus::kBadLength:
-      return "bad_length";
-    case DecodeStatus::kBadCrc:
-      return "bad_crc";
-    case DecodeStatus::kBadField:
-      return "bad_field";
-  }
-  return "unknown";
-}
-
 std::size_t EncodeSensorFrame(const SensorFrame& f, uint8_t* out) {
   Writer w(out);
   WriteHeader(&w, FrameType::kSensor, kSensorPayloadSize, f.seq);

@@ -46,8 +46,8 @@ int main(int argc, char** argv) {
                        "6 values (default: plant_sim.initial_velocity)")
             ->expected(6);
         app.add_option("--integrator", integrator,
-                       "arkode_erk | cvode_bdf | cvode_adams (default: config)")
-            ->check(CLI::IsMember({"arkode_erk", "cvode_bdf", "cvode_adams"}));
+                       stewart::kOdeMethodNames.Names() + " (default: config)")
+            ->check(CLI::IsMember(stewart::kOdeMethodNames.NameList()));
         app.add_option("--rate-hz", rate_hz,
                        "sensor and control tick rate (default: sensors.rate_hz)")
             ->check(CLI::PositiveNumber);

@@ -24,26 +24,6 @@ OdeOptions OdeOptionsFrom(const PlantSimConfig& config) {
   return o;
 }
 
-OdeMethod ParseOdeMethod(const std::string& name) {
-  if (name == "arkode_erk") return OdeMethod::kArkodeErk;
-  if (name == "cvode_bdf") return OdeMethod::kCvodeBdf;
-  if (name == "cvode_adams") return OdeMethod::kCvodeAdams;
-  throw std::invalid_argument("unknown integrator '" + name +
-                              "' (arkode_erk | cvode_bdf | cvode_adams)");
-}
-
-std::string ToString(OdeMethod method) {
-  switch (method) {
-    case OdeMethod::kArkodeErk:
-      return "arkode_erk";
-    case OdeMethod::kCvodeBdf:
-      return "cvode_bdf";
-    case OdeMethod::kCvodeAdams:
-      return "cvode_adams";
-  }
-  return "?";
-}
-
 struct OdeIntegrator::Impl {
   OdeRhsFn rhs = nullptr;
   OdeRootFn roots = nullptr;

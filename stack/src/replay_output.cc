@@ -10,19 +10,6 @@ namespace {
 
 using nlohmann::ordered_json;
 
-
-const char* KindName(SafetyStepKind kind) {
-  switch (kind) {
-    case SafetyStepKind::kCompared:
-      return "compared";
-    case SafetyStepKind::kFallback:
-      return "fallback";
-    case SafetyStepKind::kUnrecorded:
-      return "unrecorded";
-  }
-  return "?";
-}
-
 // JSON has no inf or NaN: null instead.
 ordered_json Number(double value) {
   return std::isfinite(value) ? ordered_json(value) : ordered_json(nullptr);
@@ -302,7 +289,7 @@ void WriteSafetyStepsCsv(const SafetyReplayResult& safety, std::ostream& out) {
   for (int i = 0; i < 6; ++i) out << ",f_recorded" << i << "_n";
   out << '\n' << std::setprecision(17);
   for (const SafetyStep& step : safety.steps) {
-    out << step.sample_utime << ',' << KindName(step.kind) << ',' << step.replayed_flags << ','
+    out << step.sample_utime << ',' << kSafetyStepKindNames.Name(step.kind) << ',' << step.replayed_flags << ','
         << step.recorded_flags << ',' << static_cast<int>(step.replayed_case) << ','
         << step.replayed_ns << ',' << step.recorded_ns;
     for (double f : step.f_replayed) out << ',' << f;

@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <optional>
 
+#include "stewart/common/enum_table.h"
 #include "stewart/controller/controller_config.h"
 #include "stewart/controller/control_law.h"
 #include "stewart/controller/scenario.h"
@@ -14,8 +15,22 @@ namespace stewart {
 enum class SetpointStatus { kAccepted, kNonFinite, kOutsideWorkspace };
 enum class StepStatus { kOk, kNonFiniteState, kTimeNotIncreasing, kNonFiniteForce };
 
-const char* ToString(SetpointStatus status);
-const char* ToString(StepStatus status);
+inline constexpr EnumTable<SetpointStatus, 3> kSetpointStatusNames{{{
+    {SetpointStatus::kAccepted, "accepted"},
+    {SetpointStatus::kNonFinite, "setpoint_non_finite"},
+    {SetpointStatus::kOutsideWorkspace, "setpoint_outside_workspace"},
+}}};
+inline constexpr EnumTable<StepStatus, 4> kStepStatusNames{{{
+    {StepStatus::kOk, "ok"},
+    {StepStatus::kNonFiniteState, "state_non_finite"},
+    {StepStatus::kTimeNotIncreasing, "state_time_not_increasing"},
+    {StepStatus::kNonFiniteForce, "force_non_finite"},
+}}};
+/// The names health_t counts rejections under.
+inline const char* ToString(SetpointStatus status) {
+  return kSetpointStatusNames.Name(status).data();
+}
+inline const char* ToString(StepStatus status) { return kStepStatusNames.Name(status).data(); }
 
 struct ControllerOutput {
   Vector6d force_n = Vector6d::Zero();  ///< F_des (N)

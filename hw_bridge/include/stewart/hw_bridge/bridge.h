@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <string>
 
+#include "stewart/common/enum_table.h"
 #include "stewart/hw_bridge/calibration.h"
 #include "stewart/hw_bridge/drive_map.h"
 #include "stewart/hw_bridge/hw_bridge_config.h"
@@ -34,7 +35,13 @@ enum class DriveReason {
   kStale,    ///< the held command is older than command_timeout_s: zero drive
   kInvalid,  ///< the latest command was non-finite: zero drive
 };
-const char* ToString(DriveReason reason);
+inline constexpr EnumTable<DriveReason, 4> kDriveReasonNames{{{
+    {DriveReason::kCommand, "command"},
+    {DriveReason::kMissing, "missing"},
+    {DriveReason::kStale, "stale"},
+    {DriveReason::kInvalid, "invalid"},
+}}};
+inline const char* ToString(DriveReason reason) { return kDriveReasonNames.Name(reason).data(); }
 
 enum class CommandVerdict {
   kAccepted,
@@ -43,7 +50,15 @@ enum class CommandVerdict {
   kFuture,      ///< newer than the newest sample by more than the timeout:
                 ///< another time base (a second stack?), ignored
 };
-const char* ToString(CommandVerdict verdict);
+inline constexpr EnumTable<CommandVerdict, 4> kCommandVerdictNames{{{
+    {CommandVerdict::kAccepted, "accepted"},
+    {CommandVerdict::kNonFinite, "non_finite_command"},
+    {CommandVerdict::kOutOfOrder, "out_of_order_command"},
+    {CommandVerdict::kFuture, "future_command"},
+}}};
+inline const char* ToString(CommandVerdict verdict) {
+  return kCommandVerdictNames.Name(verdict).data();
+}
 
 /// Whether a command frame goes out as soon as the command is in: a valid
 /// command at once, and a non-finite one at once as zero drive. An ignored

@@ -5,6 +5,7 @@
 //
 //   sync 0xA5 0x5A | version u8 | type u8 | payload_length u16 | seq u32 |
 //   payload (payload_length bytes) | crc32 u32 over version..payload
+#include "stewart/common/enum_table.h"
 #include <algorithm>
 #include <array>
 #include <cstddef>
@@ -78,8 +79,18 @@ enum class DecodeStatus {
   kBadCrc,
   kBadField,  ///< CRC fine but a field out of range (drive -32768, watchdog)
 };
+inline constexpr EnumTable<DecodeStatus, 8> kDecodeStatusNames{{{
+    {DecodeStatus::kOk, "ok"},
+    {DecodeStatus::kNeedMore, "truncated"},
+    {DecodeStatus::kBadSync, "bad_sync"},
+    {DecodeStatus::kBadVersion, "bad_version"},
+    {DecodeStatus::kBadType, "bad_type"},
+    {DecodeStatus::kBadLength, "bad_length"},
+    {DecodeStatus::kBadCrc, "bad_crc"},
+    {DecodeStatus::kBadField, "bad_field"},
+}}};
 
-const char* ToString(DecodeStatus status);
+inline const char* ToString(DecodeStatus status) { return kDecodeStatusNames.Name(status).data(); }
 
 struct DecodedFrame {
   FrameType type = FrameType::kSensor;

@@ -11,15 +11,23 @@
 #include <memory>
 #include <string>
 
+#include "stewart/common/enum_table.h"
 #include "stewart/plant_sim/plant_sim_config.h"
 
 namespace stewart {
 
 enum class OdeMethod { kArkodeErk, kCvodeBdf, kCvodeAdams };
+inline constexpr EnumTable<OdeMethod, 3> kOdeMethodNames{{{
+    {OdeMethod::kArkodeErk, "arkode_erk"},
+    {OdeMethod::kCvodeBdf, "cvode_bdf"},
+    {OdeMethod::kCvodeAdams, "cvode_adams"},
+}}};
 
-/// "arkode_erk" | "cvode_bdf" | "cvode_adams"; throws std::invalid_argument.
-OdeMethod ParseOdeMethod(const std::string& name);
-std::string ToString(OdeMethod method);
+/// Throws InputError (an std::invalid_argument) listing the names.
+inline OdeMethod ParseOdeMethod(const std::string& name) {
+  return kOdeMethodNames.Parse(name, "integrator");
+}
+inline std::string ToString(OdeMethod method) { return std::string(kOdeMethodNames.Name(method)); }
 
 /// y' = f(t, y). Return 0 on success, > 0 for a recoverable failure (the
 /// integrator retries with a smaller step), < 0 to abort.

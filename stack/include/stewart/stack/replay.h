@@ -17,6 +17,7 @@
 #include <utility>
 #include <vector>
 
+#include "stewart/common/enum_table.h"
 #include "stewart/config/stack_config.h"
 #include "stewart/controller/scenario.h"
 #include "stewart/force_command_t.hpp"
@@ -120,6 +121,11 @@ enum class SafetyStepKind {
   kFallback,    ///< the live node answered with a fallback (FLAG_FALLBACK / FLAG_STALE_INPUT)
   kUnrecorded,  ///< no recorded safe command with this sample_utime
 };
+inline constexpr EnumTable<SafetyStepKind, 3> kSafetyStepKindNames{{{
+    {SafetyStepKind::kCompared, "compared"},
+    {SafetyStepKind::kFallback, "fallback"},
+    {SafetyStepKind::kUnrecorded, "unrecorded"},
+}}};
 
 /// One replayed filter step (one recorded nominal command with its state).
 struct SafetyStep {
