@@ -16,7 +16,7 @@ SensorConfig ParseSensorConfig(const ConfigNode& sensors) {
   s.gyro_bias_radps = sensors.Vec3("gyro_bias_radps");
   s.accel_noise_std_mps2 = sensors.NonNegativeDouble("accel_noise_std_mps2");
   s.accel_bias_mps2 = sensors.Vec3("accel_bias_mps2");
-  s.imu_offset_m = sensors.Vec3("imu_offset_m");
+  s.imu_offset_in_P_m = sensors.Vec3("imu_offset_m");
   s.has_orientation = sensors.Bool("has_orientation");
   s.orientation_noise_std_rad = sensors.NonNegativeDouble("orientation_noise_std_rad");
   const int seed = sensors.Int("seed");

@@ -25,7 +25,7 @@ void BM_EkfUpdate(benchmark::State& state, stewart::EstimatorProcessModel model)
   SensorSample s;
   s.leg_length_m = InverseKinematics(c.platform, q);
   s.gyro_radps = BodyAngularVelocity(q, qd);
-  s.accel_mps2 = ImuSpecificForce(q, qd, qdd, c.sensors.imu_offset_m, c.platform.gravity_mps2);
+  s.accel_mps2 = ImuSpecificForce(q, qd, qdd, c.sensors.imu_offset_in_P_m, c.platform.gravity_mps2);
   EkfVector std = EkfVector::Constant(1e-3);
   ekf.Initialize(0, q, qd, std);
   int64_t utime = 0;

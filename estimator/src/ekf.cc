@@ -33,7 +33,7 @@ Ekf::Ekf(const PlatformParams& params, const ActuatorConfig& actuators, const Se
       actuators_(actuators),
       config_(config),
       home_pose_(home_pose),
-      imu_offset_m_(sensors.imu_offset_m) {
+      imu_offset_m_(sensors.imu_offset_in_P_m) {
   const double step = LegAdcStepM(sensors, actuators.stroke_m);
   // The quantisation error is uniform over one ADC step: variance step^2/12.
   leg_variance_m2_ =

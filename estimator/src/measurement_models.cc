@@ -54,10 +54,10 @@ void PredictGyro(const EkfVector& x, Vector3d* gyro_radps, MeasurementJacobian<3
   CentralDifference(x, kEkfQ + 3, 3, h, jacobian);
 }
 
-void PredictAccel(const EkfVector& x, const Vector6d& qdd, const Vector3d& imu_offset_m,
+void PredictAccel(const EkfVector& x, const Vector6d& qdd, const Vector3d& imu_offset_in_P_m,
                   double gravity_mps2, Vector3d* accel_mps2, MeasurementJacobian<3>* jacobian) {
   const auto h = [&](const EkfVector& s) -> Vector3d {
-    return ImuSpecificForce(s.segment<6>(kEkfQ), s.segment<6>(kEkfQd), qdd, imu_offset_m,
+    return ImuSpecificForce(s.segment<6>(kEkfQ), s.segment<6>(kEkfQd), qdd, imu_offset_in_P_m,
                             gravity_mps2);
   };
   *accel_mps2 = h(x);
@@ -69,15 +69,15 @@ void PredictAccel(const EkfVector& x, const Vector6d& qdd, const Vector3d& imu_o
 }
 
 Eigen::Matrix<double, 3, 6> AccelQddJacobian(const EkfVector& x, const Vector6d& qdd,
-                                             const Vector3d& imu_offset_m, double gravity_mps2) {
+                                             const Vector3d& imu_offset_in_P_m, double gravity_mps2) {
   Eigen::Matrix<double, 3, 6> d;
   const Vector6d q = x.segment<6>(kEkfQ), qd = x.segment<6>(kEkfQd);
   // Affine in qdd: a unit difference is exact.
-  const Vector3d base = ImuSpecificForce(q, qd, qdd, imu_offset_m, gravity_mps2);
+  const Vector3d base = ImuSpecificForce(q, qd, qdd, imu_offset_in_P_m, gravity_mps2);
   for (int i = 0; i < 6; ++i) {
     Vector6d e = qdd;
     e(i) += 1.0;
-    d.col(i) = ImuSpecificForce(q, qd, e, imu_offset_m, gravity_mps2) - base;
+    d.col(i) = ImuSpecificForce(q, qd, e, imu_offset_in_P_m, gravity_mps2) - base;
   }
   return d;
 }

@@ -114,7 +114,7 @@ void EvaluateDynamics(const PlatformParams& params, const Vector6d& q, const Vec
   terms->H.bottomRows<3>().noalias() = E.transpose() * u.matrix();
 
   // Platform CoM and inertia.
-  const Vector3d c = R * params.platform_com_m;
+  const Vector3d c = R * params.platform_com_in_P_m;
   const double m = params.platform_mass_kg;
   const Vector3d w_c = omega.cross(c);
   const Vector3d f_c = m * (omegad_bias.cross(c) + omega.cross(w_c));  // m a_bias at the CoM
@@ -183,12 +183,12 @@ double PotentialEnergy(const PlatformParams& params, const Vector6d& q) {
   const LegGeometry legs = ComputeLegGeometry(params, q);
   const Matrix3d R = RotationFromEuler(q.tail<3>());
   const double g = params.gravity_mps2;
-  double v = g * params.platform_mass_kg * (q(2) + (R * params.platform_com_m).z());
+  double v = g * params.platform_mass_kg * (q(2) + (R * params.platform_com_in_P_m).z());
   const LegParams& leg = params.leg;
   for (int i = 0; i < kNumLegs; ++i) {
-    const double n_z = legs.unit_m(2, i);
-    const double a_z = q(2) + legs.platform_offset_m(2, i);
-    const double b_z = params.base_joints_m(2, i);
+    const double n_z = legs.unit_in_B(2, i);
+    const double a_z = q(2) + legs.platform_offset_in_B_m(2, i);
+    const double b_z = params.base_joints_in_B_m(2, i);
     v += g * leg.cylinder_mass_kg * (b_z + leg.cylinder_com_from_base_m * n_z);
     v += g * leg.rod_mass_kg * (a_z - leg.rod_com_from_platform_m * n_z);
   }

@@ -13,8 +13,8 @@ LegGeometry ComputeLegGeometry(const PlatformParams& params, const Vector6d& q) 
   const internal::LegArrays arrays =
       internal::ComputeLegArrays(params, RotationFromEuler(q.tail<3>()), q.head<3>());
   LegGeometry legs;
-  legs.platform_offset_m = arrays.offset.matrix();
-  legs.unit_m = arrays.unit.matrix();
+  legs.platform_offset_in_B_m = arrays.offset.matrix();
+  legs.unit_in_B = arrays.unit.matrix();
   legs.length_m = arrays.length.transpose();
   return legs;
 }
@@ -27,9 +27,9 @@ Matrix6d LegLengthJacobian(const LegGeometry& legs, const Vector3d& rpy_rad) {
   const Matrix3d E = EulerRateMatrix(rpy_rad);
   Matrix6d J;
   for (int i = 0; i < kNumLegs; ++i) {
-    const Vector3d n = legs.unit_m.col(i);
+    const Vector3d n = legs.unit_in_B.col(i);
     J.block<1, 3>(i, 0) = n.transpose();
-    J.block<1, 3>(i, 3) = (legs.platform_offset_m.col(i).cross(n)).transpose() * E;
+    J.block<1, 3>(i, 3) = (legs.platform_offset_in_B_m.col(i).cross(n)).transpose() * E;
   }
   return J;
 }

@@ -51,8 +51,8 @@ struct LegArrays {
 inline LegArrays ComputeLegArrays(const PlatformParams& params, const Matrix3d& R,
                                   const Vector3d& t) {
   LegArrays legs;
-  legs.offset = (R * params.platform_joints_m).array();
-  const LegVectors leg = (legs.offset.colwise() + t.array()) - params.base_joints_m.array();
+  legs.offset = (R * params.platform_joints_in_P_m).array();
+  const LegVectors leg = (legs.offset.colwise() + t.array()) - params.base_joints_in_B_m.array();
   legs.length = leg.square().colwise().sum().sqrt();
   legs.inverse_length = legs.length.inverse();
   legs.unit = leg.rowwise() * legs.inverse_length;

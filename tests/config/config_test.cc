@@ -39,8 +39,8 @@ void ExpectConfigError(const std::function<void(YAML::Node&)>& mutate, const std
 
 TEST(Config, DefaultLoadsWithPaperValues) {
   const StackConfig c = LoadStackConfig(DefaultConfigPath());
-  EXPECT_DOUBLE_EQ(c.platform.base_joints_m.col(0).norm(), 0.20);
-  EXPECT_DOUBLE_EQ(c.platform.platform_joints_m.col(0).norm(), 0.16);
+  EXPECT_DOUBLE_EQ(c.platform.base_joints_in_B_m.col(0).norm(), 0.20);
+  EXPECT_DOUBLE_EQ(c.platform.platform_joints_in_P_m.col(0).norm(), 0.16);
   EXPECT_DOUBLE_EQ(c.platform.leg_max_length_m - c.platform.leg_min_length_m, 0.2);
   EXPECT_DOUBLE_EQ(c.home_pose(2), 0.4);
   EXPECT_EQ(c.safety.position_limits.size(), 3u);

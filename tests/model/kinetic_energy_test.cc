@@ -27,12 +27,12 @@ struct BodyPositions {
 BodyPositions PositionsAt(const PlatformParams& p, const Vector6d& q) {
   BodyPositions b;
   b.R = RotationFromEuler(q.tail<3>());
-  b.platform_com = q.head<3>() + b.R * p.platform_com_m;
+  b.platform_com = q.head<3>() + b.R * p.platform_com_in_P_m;
   const LegGeometry legs = ComputeLegGeometry(p, q);
-  b.unit = legs.unit_m;
+  b.unit = legs.unit_in_B;
   for (int i = 0; i < kNumLegs; ++i) {
-    const Vector3d a = q.head<3>() + legs.platform_offset_m.col(i);
-    b.rod_com.col(i) = a - p.leg.rod_com_from_platform_m * legs.unit_m.col(i);
+    const Vector3d a = q.head<3>() + legs.platform_offset_in_B_m.col(i);
+    b.rod_com.col(i) = a - p.leg.rod_com_from_platform_m * legs.unit_in_B.col(i);
   }
   return b;
 }

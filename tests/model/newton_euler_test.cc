@@ -29,15 +29,15 @@ TEST(NewtonEuler, MasslessLegsEqualRigidPlatform) {
     const Matrix3d E = EulerRateMatrix(rpy);
     const Vector3d omega = E * rpyd;
     const Vector3d alpha = E * rpydd + EulerRateBiasAcceleration(rpy, rpyd);
-    const Vector3d c = R * p.platform_com_m;
+    const Vector3d c = R * p.platform_com_in_P_m;
     const Vector3d a_com = qdd.head<3>() + alpha.cross(c) + omega.cross(omega.cross(c));
     const LegGeometry legs = ComputeLegGeometry(p, q);
     Vector3d force_sum = Vector3d(0, 0, -p.gravity_mps2 * p.platform_mass_kg);
     Vector3d moment_about_com = Vector3d::Zero();
     for (int i = 0; i < 6; ++i) {
-      const Vector3d f = F(i) * legs.unit_m.col(i);
+      const Vector3d f = F(i) * legs.unit_in_B.col(i);
       force_sum += f;
-      moment_about_com += (legs.platform_offset_m.col(i) - c).cross(f);
+      moment_about_com += (legs.platform_offset_in_B_m.col(i) - c).cross(f);
     }
     const Matrix3d I = R * p.platform_inertia_kgm2.asDiagonal() * R.transpose();
     EXPECT_LT((p.platform_mass_kg * a_com - force_sum).norm(), 1e-9);

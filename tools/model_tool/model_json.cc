@@ -61,8 +61,8 @@ nlohmann::json EvaluateModelQuery(const PlatformParams& params, const ModelQuery
   const LegGeometry legs = ComputeLegGeometry(params, query.q);
   nlohmann::json base = nlohmann::json::array(), top = nlohmann::json::array();
   for (int i = 0; i < kNumLegs; ++i) {
-    const Vector3d b = params.base_joints_m.col(i);
-    const Vector3d a = query.q.head<3>() + legs.platform_offset_m.col(i);
+    const Vector3d b = params.base_joints_in_B_m.col(i);
+    const Vector3d a = query.q.head<3>() + legs.platform_offset_in_B_m.col(i);
     base.push_back({b.x(), b.y(), b.z()});
     top.push_back({a.x(), a.y(), a.z()});
   }

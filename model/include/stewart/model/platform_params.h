@@ -21,12 +21,12 @@ struct LegParams {
 
 struct PlatformParams {
   /// Base joint centres b_i in {B} (m), one column per leg.
-  Eigen::Matrix<double, 3, kNumLegs> base_joints_m;
+  Eigen::Matrix<double, 3, kNumLegs> base_joints_in_B_m;
   /// Platform joint centres p_i in {P} (m), one column per leg.
-  Eigen::Matrix<double, 3, kNumLegs> platform_joints_m;
+  Eigen::Matrix<double, 3, kNumLegs> platform_joints_in_P_m;
 
   double platform_mass_kg = 0.0;
-  Vector3d platform_com_m = Vector3d::Zero();  ///< in {P}
+  Vector3d platform_com_in_P_m = Vector3d::Zero();  ///< in {P}
   /// Principal inertia about the CoM, axes of {P} (kg m^2): Ixx, Iyy, Izz.
   Vector3d platform_inertia_kgm2 = Vector3d::Zero();
 

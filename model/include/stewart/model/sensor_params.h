@@ -13,7 +13,7 @@ struct SensorConfig {
   Vector3d gyro_bias_radps = Vector3d::Zero();
   double accel_noise_std_mps2 = 0.0;
   Vector3d accel_bias_mps2 = Vector3d::Zero();
-  Vector3d imu_offset_m = Vector3d::Zero();  ///< IMU position in {P}
+  Vector3d imu_offset_in_P_m = Vector3d::Zero();  ///< IMU position in {P}
   bool has_orientation = false;
   double orientation_noise_std_rad = 0.0;
   unsigned seed = 0;

@@ -1,6 +1,15 @@
 #pragma once
 // Fixed-size Eigen types shared by every component. Fixed sizes keep the hot
 // paths free of heap allocation.
+//
+// Names and frames, one convention for the whole tree (docs/model.md, "Names
+// and frames"): a name ends in its unit (`_m`, `_rad`, `_n`, `_mps`,
+// `_kgm2`; none for a dimensionless value), and a vector whose frame matters
+// names the frame it is expressed in before the unit: `_in_B` for the base
+// frame {B} (z up, origin at the centre of the base joint circle), `_in_P`
+// for the platform frame {P} (origin at the centre of the platform joint
+// circle). `base_joints_in_B_m` are lengths in {B}; `unit_in_B` are unit
+// vectors in {B}. q = [x y z phi theta psi] is the pose of {P} in {B}.
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <array>

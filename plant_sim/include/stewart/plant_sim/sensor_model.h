@@ -34,7 +34,7 @@ class SensorModel {
   /// One sample of the true motion (q, qd, qdd at one instant):
   ///   legs   = ADC(L(q) + n_L),                n_L ~ N(0, leg_pot_noise_std_m^2)
   ///   gyro   = BodyAngularVelocity + b_g + n_g
-  ///   accel  = ImuSpecificForce(at imu_offset_m) + b_a + n_a
+  ///   accel  = ImuSpecificForce(at imu_offset_in_P_m) + b_a + n_a
   ///   orient = [phi theta psi] + n_o           (only if has_orientation)
   SensorReading Sample(const Vector6d& q, const Vector6d& qd, const Vector6d& qdd,
                        const Vector6d& leg_length_m);
