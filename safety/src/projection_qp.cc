@@ -68,6 +68,7 @@ void Polish(const ProjectionQpN<MaxRows>& qp, const std::array<int, 6>& active, 
 
 template <int MaxRows>
 ProjectionResultN<MaxRows> SolveProjectionQp(const ProjectionQpN<MaxRows>& qp) {
+  STEWART_CHECK(qp.m >= 0 && qp.m <= MaxRows, "SolveProjectionQp: m outside [0, MaxRows]");
   ProjectionResultN<MaxRows> res;
   res.mu.setZero();
   res.x = qp.x0;
