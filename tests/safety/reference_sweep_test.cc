@@ -17,9 +17,9 @@ namespace {
 
 constexpr int kSamples = 100000;
 constexpr double kRelTol = 1e-9;
-// Clp reaches the same 1e-9 once its automatic scaling is off and its
-// tolerances are 1e-12 (ClpReferenceQp; with scaling on it returned optima
-// off by up to 50 % in the acceleration metric's coordinates).
+// Clp reaches the same 1e-9 with its automatic scaling off and its
+// tolerances at 1e-12 (ClpReferenceQp; with scaling on, its optima are off
+// by up to 50 % in the acceleration metric's coordinates).
 constexpr double kClpRelTol = 1e-9;
 
 void Sweep(ReferenceQpSolver* reference, bool force_limits, CorrectionMetric metric, int samples,
