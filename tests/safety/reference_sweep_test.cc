@@ -35,11 +35,7 @@ void Sweep(ReferenceQpSolver* reference, bool force_limits, CorrectionMetric met
   int paper_differs = 0, both_infeasible = 0;
   double worst = 0.0;
   for (int n = 0; n < samples; ++n) {
-    const FilterInput x = RandomFilterInput(&rng);
-    const Vector6d& q = x.q;
-    const Vector6d& qd = x.qd;
-    const DynamicsTerms& terms = x.terms;
-    const Vector6d& f_des = x.f_des;
+    const auto [q, qd, f_des, terms] = RandomFilterInput(&rng);
     SafetyDiagnostics d;
     const Vector6d f = filter.StepWithTerms(terms, q, qd, f_des, &d);
     ++cases[static_cast<size_t>(d.filter_case)];
