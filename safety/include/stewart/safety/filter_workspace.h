@@ -35,7 +35,9 @@ struct PosedQp {
 using ComposedQpData = PosedQp<kMaxQpRows, QpRows>;
 using UncomposedQpData = PosedQp<kMaxUncomposedQpRows, UncomposedQpRows>;
 
-struct FilterWorkspace {
+// On a cache line of its own, so that which lines a step touches does not
+// depend on where the filter holding it sits.
+struct alignas(64) FilterWorkspace {
   DynamicsTerms terms;              ///< model terms at (q, qd), evaluated by Step
   BarrierIntermediates barrier;     ///< what EvaluateBarriers leaves for the solve
   Matrix6d metric_map;              ///< T (SafetyFilter::MetricMap), when a QP is posed
