@@ -171,7 +171,8 @@ void SafetyFilter::SolveUncomposed(const StepInput& in, FilterWorkspace* ws,
   double mu_p = 0.0, mu_v = 0.0;
   for (int i = 0; i < c.num_position; ++i) {
     const size_t k = static_cast<size_t>(i);
-    d->mu_position[k] = ConditionMultiplier(r.mu.data(), rows.position_row[k], rows.position_norm[k]);
+    d->mu_position[k] =
+        ConditionMultiplier(r.mu.data(), rows.position_row[k], rows.position_norm[k]);
     mu_p += d->mu_position[k];
   }
   const UncomposedQpRows& v_rows = split ? velocity.rows : rows;
