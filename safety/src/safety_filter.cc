@@ -3,8 +3,8 @@
 #include <Eigen/QR>
 #include <chrono>
 #include <cmath>
-#include <stdexcept>
 
+#include "stewart/common/check.h"
 #include "stewart/model/linear_algebra6.h"
 
 namespace stewart::safety {
@@ -72,20 +72,16 @@ SafetyFilter::SafetyFilter(const PlatformParams& platform, const SafetyConfig& s
       fallback_(safety.fallback),
       stop_time_s_(safety.stop_time_s),
       reference_(reference) {
-  if (!(force_limit_n_ > 0.0) && force_limits_) {
-    throw std::invalid_argument("safety: force limits enabled but actuators.force_limit_n <= 0");
-  }
-  if (!(stop_time_s_ > 0.0)) throw std::invalid_argument("safety: stop_time_s must be positive");
-  if (!(leg_friction_nspm_ >= 0.0)) {
-    throw std::invalid_argument("safety: leg_friction_nspm must be >= 0");
-  }
+  STEWART_CHECK_INPUT(force_limit_n_ > 0.0 || !force_limits_, "actuators.force_limit_n",
+                      "must be positive when safety.force_limits_enabled");
+  STEWART_CHECK_INPUT(stop_time_s_ > 0.0, "safety.stop_time_s", "must be positive");
+  STEWART_CHECK_INPUT(leg_friction_nspm_ >= 0.0, "safety.leg_friction_nspm", "must be >= 0");
   set_variant(variant_);
 }
 
 void SafetyFilter::set_variant(SafetyVariant variant) {
-  if (variant == SafetyVariant::kQpReference && reference_ == nullptr) {
-    throw std::invalid_argument("safety: variant 'qp' needs a reference QP solver");
-  }
+  STEWART_CHECK_INPUT(variant != SafetyVariant::kQpReference || reference_ != nullptr,
+                      "safety.variant", "'qp' needs a reference QP solver");
   variant_ = variant;
 }
 

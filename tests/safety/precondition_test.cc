@@ -1,5 +1,5 @@
 // A broken precondition in safety/ is a programmer error: STEWART_CHECK
-// throws std::logic_error instead of writing past an array.
+// throws std::logic_error rather than let the step write past an array.
 #include <gtest/gtest.h>
 
 #include <stdexcept>
@@ -54,6 +54,21 @@ TEST(Preconditions, BarriersWithinTheirArrays) {
   c.num_velocity = 0;
   c.num_position = -1;
   EXPECT_THROW(EvaluateBarriers(c, q, Vector6d::Zero(), t, HoverForce(q), &e), std::logic_error);
+}
+
+// Bad user input is not a programmer error: InputError names the config key.
+TEST(Preconditions, UnusableConfigNamesItsKey) {
+  SafetyConfig s = RichSafetyConfig();
+  s.stop_time_s = 0.0;
+  try {
+    SafetyFilter(DefaultConfig().platform, s, DefaultConfig().actuators);
+    ADD_FAILURE() << "no InputError";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.key(), "safety.stop_time_s");
+  }
+  s = RichSafetyConfig();
+  s.k_velocity = -1.0;
+  EXPECT_THROW(BuildConstraintSet(DefaultConfig().platform, s), InputError);
 }
 
 }  // namespace

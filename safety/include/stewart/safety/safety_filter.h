@@ -28,8 +28,9 @@ constexpr double kMaxInputForceN = 1e7;
 
 class SafetyFilter {
  public:
-  /// Throws std::invalid_argument for an unusable config, or variant "qp"
-  /// without a reference solver (which must outlive the filter).
+  /// Throws InputError (a std::invalid_argument naming the config key) for an
+  /// unusable config, or variant "qp" without a reference solver (which must
+  /// outlive the filter).
   SafetyFilter(const PlatformParams& platform, const SafetyConfig& safety,
                const ActuatorConfig& actuators, ReferenceQpSolver* reference = nullptr);
 
