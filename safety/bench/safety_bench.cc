@@ -46,29 +46,30 @@ const std::vector<Sample>& Samples() {
   return samples;
 }
 
-void RunCore(benchmark::State& state, SafetyFilter* filter) {
+// The filter on `safety` (the platform and actuators of the config file).
+void RunCore(benchmark::State& state, const SafetyConfig& safety) {
+  SafetyFilter filter(Config().platform, safety, Config().actuators);
   SafetyDiagnostics d;
   size_t i = 0;
   for (auto _ : state) {
     const Sample& s = Samples()[i++ & 255];
-    benchmark::DoNotOptimize(filter->StepWithTerms(s.terms, s.q, s.qd, s.f_des, &d));
+    benchmark::DoNotOptimize(filter.StepWithTerms(s.terms, s.q, s.qd, s.f_des, &d));
   }
 }
 
-void RunFullStep(benchmark::State& state, SafetyFilter* filter) {
+void RunFullStep(benchmark::State& state, const SafetyConfig& safety,
+                 ReferenceQpSolver* reference = nullptr) {
+  SafetyFilter filter(Config().platform, safety, Config().actuators, reference);
   SafetyDiagnostics d;
   size_t i = 0;
   for (auto _ : state) {
     const Sample& x = Samples()[i++ & 255];
-    benchmark::DoNotOptimize(filter->Step(x.q, x.qd, x.f_des, &d));
+    benchmark::DoNotOptimize(filter.Step(x.q, x.qd, x.f_des, &d));
   }
 }
 
 // (a) the closed form given the model terms.
-void BM_ClosedFormCore(benchmark::State& state) {
-  SafetyFilter filter(Config().platform, Config().safety, Config().actuators);
-  RunCore(state, &filter);
-}
+void BM_ClosedFormCore(benchmark::State& state) { RunCore(state, Config().safety); }
 BENCHMARK(BM_ClosedFormCore);
 
 // (a) on the states where a constraint acts only (about half of the set): the
@@ -91,26 +92,21 @@ void BM_ClosedFormCoreActiveOnly(benchmark::State& state) {
 BENCHMARK(BM_ClosedFormCoreActiveOnly);
 
 // (b) the full step including M, C qd, G, H.
-void BM_ClosedFormFullStep(benchmark::State& state) {
-  SafetyFilter filter(Config().platform, Config().safety, Config().actuators);
-  RunFullStep(state, &filter);
-}
+void BM_ClosedFormFullStep(benchmark::State& state) { RunFullStep(state, Config().safety); }
 BENCHMARK(BM_ClosedFormFullStep);
 
 // (a) with the paper's force metric (no metric map per step).
 void BM_ClosedFormCoreForceMetric(benchmark::State& state) {
   SafetyConfig s = Config().safety;
   s.correction_metric = CorrectionMetric::kForce;
-  SafetyFilter filter(Config().platform, s, Config().actuators);
-  RunCore(state, &filter);
+  RunCore(state, s);
 }
 BENCHMARK(BM_ClosedFormCoreForceMetric);
 
 void BM_PaperRuleCore(benchmark::State& state) {
   SafetyConfig s = Config().safety;
   s.variant = SafetyVariant::kPaperRule;
-  SafetyFilter filter(Config().platform, s, Config().actuators);
-  RunCore(state, &filter);
+  RunCore(state, s);
 }
 BENCHMARK(BM_PaperRuleCore);
 
@@ -120,8 +116,7 @@ void BM_QpReferenceFullStep(benchmark::State& state) {
   Solver solver;
   SafetyConfig s = Config().safety;
   s.variant = SafetyVariant::kQpReference;
-  SafetyFilter filter(Config().platform, s, Config().actuators, &solver);
-  RunFullStep(state, &filter);
+  RunFullStep(state, s, &solver);
 }
 BENCHMARK_TEMPLATE(BM_QpReferenceFullStep, ClpReferenceQp);
 #ifdef STEWART_HAVE_ALGLIB
@@ -132,8 +127,7 @@ BENCHMARK_TEMPLATE(BM_QpReferenceFullStep, AlglibReferenceQp);
 void BM_ForceLimitedFullStep(benchmark::State& state) {
   SafetyConfig s = Config().safety;
   s.force_limits_enabled = true;
-  SafetyFilter filter(Config().platform, s, Config().actuators);
-  RunFullStep(state, &filter);
+  RunFullStep(state, s);
 }
 BENCHMARK(BM_ForceLimitedFullStep);
 
@@ -143,8 +137,7 @@ void BM_UncomposedFullStep(benchmark::State& state) {
   SafetyConfig s = Config().safety;
   s.variant = SafetyVariant::kUncomposed;
   s.force_limits_enabled = state.range(0) != 0;
-  SafetyFilter filter(Config().platform, s, Config().actuators);
-  RunFullStep(state, &filter);
+  RunFullStep(state, s);
 }
 BENCHMARK(BM_UncomposedFullStep)->ArgName("force_limits")->Arg(0)->Arg(1);
 

@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "stewart/common/check.h"
 #include "stewart/safety/log_sum_exp.h"
 
 namespace stewart::safety {
@@ -15,6 +16,11 @@ void EvaluateBarriers(const ConstraintSet& c, const Vector6d& q, const Vector6d&
 void EvaluateBarriers(const ConstraintSet& c, const Vector6d& q, const Vector6d& qd,
                       const DynamicsTerms& terms, const Vector6d& f_des, double leg_friction_nspm,
                       BarrierEvaluation* out, BarrierIntermediates* x) {
+  // The per-barrier arrays hold kMax* entries (a hand-built ConstraintSet
+  // skips BuildConstraintSet's capacity check).
+  STEWART_CHECK(static_cast<unsigned>(c.num_position) <= kMaxPositionBarriers &&
+                    static_cast<unsigned>(c.num_velocity) <= kMaxVelocityBarriers,
+                "EvaluateBarriers: more barriers than their arrays hold");
   BarrierEvaluation& e = *out;
   x->leg_rate.noalias() = terms.H.transpose() * qd;  // ld = J_l qd, J_l = H^T
   // The conditions hold for what the legs really push: F + friction.

@@ -1,29 +1,27 @@
 #include "stewart/safety/constraint_set.h"
 
-#include <stdexcept>
+#include "stewart/common/check.h"
 
 namespace stewart::safety {
-namespace {
-
-void Require(bool ok, const std::string& what) {
-  if (!ok) throw std::invalid_argument("safety constraints: " + what);
-}
-
-}  // namespace
 
 ConstraintSet BuildConstraintSet(const PlatformParams& platform, const SafetyConfig& safety) {
   ConstraintSet c;
-  Require(safety.k_position > 0.0 && safety.k_velocity > 0.0, "k must be positive");
+  STEWART_CHECK_INPUT(safety.k_position > 0.0, "safety.k_position", "must be positive");
+  STEWART_CHECK_INPUT(safety.k_velocity > 0.0, "safety.k_velocity", "must be positive");
   c.k_position = safety.k_position;
   c.k_velocity = safety.k_velocity;
-  Require(safety.position_robust_margin_w >= 0.0 && safety.velocity_robust_margin_mps2 >= 0.0,
-          "robust margins must be >= 0");
+  STEWART_CHECK_INPUT(safety.position_robust_margin_w >= 0.0, "safety.position_robust_margin_w",
+                      "must be >= 0");
+  STEWART_CHECK_INPUT(safety.velocity_robust_margin_mps2 >= 0.0,
+                      "safety.velocity_robust_margin_mps2", "must be >= 0");
   c.position_margin = safety.position_robust_margin_w;
   c.velocity_margin = safety.velocity_robust_margin_mps2;
   auto add_position = [&](PositionSource source, int index, double sign, double limit,
                           double alpha_e, double alpha, const std::string& name) {
-    Require(c.num_position < kMaxPositionBarriers, "too many position limits (axis listed twice?)");
-    Require(alpha_e > 0.0 && alpha > 0.0, name + ": alpha_e and alpha must be positive");
+    STEWART_CHECK_INPUT(c.num_position < kMaxPositionBarriers, "safety.position_limits",
+                        "too many position limits (axis listed twice?)");
+    STEWART_CHECK_INPUT(alpha_e > 0.0 && alpha > 0.0, "safety constraint " + name,
+                        "alpha_e and alpha must be positive");
     c.position[static_cast<size_t>(c.num_position++)] = {source,  index, sign, limit,
                                                          alpha_e, alpha, name};
   };
@@ -40,7 +38,7 @@ ConstraintSet BuildConstraintSet(const PlatformParams& platform, const SafetyCon
     const LegStrokeLimitConfig& s = safety.leg_stroke;
     const double lower = platform.leg_min_length_m + s.margin_m;
     const double upper = platform.leg_max_length_m - s.margin_m;
-    Require(lower < upper, "leg stroke margin leaves no stroke");
+    STEWART_CHECK_INPUT(lower < upper, "safety.leg_stroke.margin_m", "leaves no stroke");
     for (int i = 0; i < kNumLegs; ++i) {
       const std::string leg = "leg" + std::to_string(i);
       add_position(PositionSource::kLegLength, i, 1.0, lower, s.alpha_e, s.alpha, leg + "_lower");
@@ -49,8 +47,9 @@ ConstraintSet BuildConstraintSet(const PlatformParams& platform, const SafetyCon
   }
   auto add_velocity = [&](int axis, double sign, double limit, double alpha_v,
                           const std::string& name) {
-    Require(c.num_velocity < kMaxVelocityBarriers, "too many velocity limits (axis listed twice?)");
-    Require(alpha_v > 0.0, name + ": alpha_v must be positive");
+    STEWART_CHECK_INPUT(c.num_velocity < kMaxVelocityBarriers, "safety.velocity_limits",
+                        "too many velocity limits (axis listed twice?)");
+    STEWART_CHECK_INPUT(alpha_v > 0.0, "safety constraint " + name, "alpha_v must be positive");
     c.velocity[static_cast<size_t>(c.num_velocity++)] = {axis, sign, limit, alpha_v, name};
   };
   for (const VelocityLimitConfig& l : safety.velocity_limits) {

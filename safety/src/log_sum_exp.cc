@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "stewart/common/check.h"
+
 namespace stewart::safety {
 namespace {
 
@@ -11,6 +13,7 @@ constexpr double kExpUnderflow = -746.0;
 }  // namespace
 
 double ComposeLogSumExp(const double* alpha_h, int n, double k, double* weights) {
+  STEWART_CHECK(n >= 1, "ComposeLogSumExp: needs at least one term");
   // A plain comparison, not std::fmin (a libm call here): a NaN entry then
   // either becomes m or is skipped, and either way reaches the sum below.
   double m = alpha_h[0];

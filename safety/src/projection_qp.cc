@@ -13,9 +13,9 @@ namespace {
 
 constexpr double kFeasTol = 1e-12;       // relative to |b| + |a| |x|
 constexpr double kDependentTol = 1e-20;  // ||z||^2 vs ||a_p||^2: a_p in span
-// Each iteration adds one constraint; 60 was ample for the 14-row QP, and a
-// bigger QP may need more active-set changes (4 per row: its value for 14
-// rows would be 56, so the composed filter keeps exactly its 60).
+// Each iteration adds one constraint, and a constraint may leave and come
+// back: 4 iterations per row, and never fewer than 60, the bound the composed
+// filter's 14-row QP is verified with (4 per row would give it 56).
 template <int MaxRows>
 constexpr int kMaxIterations = std::max(60, 4 * MaxRows);
 
@@ -68,6 +68,7 @@ void Polish(const ProjectionQpN<MaxRows>& qp, const std::array<int, 6>& active, 
 
 template <int MaxRows>
 ProjectionResultN<MaxRows> SolveProjectionQp(const ProjectionQpN<MaxRows>& qp) {
+  STEWART_CHECK(qp.m >= 0 && qp.m <= MaxRows, "SolveProjectionQp: m outside [0, MaxRows]");
   ProjectionResultN<MaxRows> res;
   res.mu.setZero();
   res.x = qp.x0;

@@ -3,8 +3,8 @@
 #include <Eigen/QR>
 #include <chrono>
 #include <cmath>
-#include <stdexcept>
 
+#include "stewart/common/check.h"
 #include "stewart/model/linear_algebra6.h"
 
 namespace stewart::safety {
@@ -72,20 +72,16 @@ SafetyFilter::SafetyFilter(const PlatformParams& platform, const SafetyConfig& s
       fallback_(safety.fallback),
       stop_time_s_(safety.stop_time_s),
       reference_(reference) {
-  if (!(force_limit_n_ > 0.0) && force_limits_) {
-    throw std::invalid_argument("safety: force limits enabled but actuators.force_limit_n <= 0");
-  }
-  if (!(stop_time_s_ > 0.0)) throw std::invalid_argument("safety: stop_time_s must be positive");
-  if (!(leg_friction_nspm_ >= 0.0)) {
-    throw std::invalid_argument("safety: leg_friction_nspm must be >= 0");
-  }
+  STEWART_CHECK_INPUT(force_limit_n_ > 0.0 || !force_limits_, "actuators.force_limit_n",
+                      "must be positive when safety.force_limits_enabled");
+  STEWART_CHECK_INPUT(stop_time_s_ > 0.0, "safety.stop_time_s", "must be positive");
+  STEWART_CHECK_INPUT(leg_friction_nspm_ >= 0.0, "safety.leg_friction_nspm", "must be >= 0");
   set_variant(variant_);
 }
 
 void SafetyFilter::set_variant(SafetyVariant variant) {
-  if (variant == SafetyVariant::kQpReference && reference_ == nullptr) {
-    throw std::invalid_argument("safety: variant 'qp' needs a reference QP solver");
-  }
+  STEWART_CHECK_INPUT(variant != SafetyVariant::kQpReference || reference_ != nullptr,
+                      "safety.variant", "'qp' needs a reference QP solver");
   variant_ = variant;
 }
 
@@ -94,12 +90,13 @@ Vector6d SafetyFilter::Step(const Vector6d& q, const Vector6d& qd, const Vector6
   // The one clock read pair of a step: compute_ns covers the model terms and
   // the filter (StepWithTerms is not timed).
   const auto start = std::chrono::steady_clock::now();
+  DynamicsTerms& terms = workspace_.terms;
   if (q.allFinite() && qd.allFinite()) {
-    EvaluateDynamics(platform_, q, qd, &terms_);
+    EvaluateDynamics(platform_, q, qd, &terms);
   } else {
-    terms_.M.setConstant(NAN);  // marks the terms invalid for StepWithTerms
+    terms.M.setConstant(NAN);  // marks the terms invalid for StepWithTerms
   }
-  const Vector6d f_safe = StepWithTerms(terms_, q, qd, f_des, diagnostics);
+  const Vector6d f_safe = StepWithTerms(terms, q, qd, f_des, diagnostics);
   diagnostics->compute_ns =
       std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - start)
           .count();
@@ -123,26 +120,28 @@ Vector6d SafetyFilter::StepWithTerms(const DynamicsTerms& terms, const Vector6d&
   // NaN compares false: this also rejects non-finite entries.
   const bool input_valid = state_valid && (f_des.array().abs() <= kMaxInputForceN).all();
   bool ok = input_valid;
-  BarrierIntermediates x;
+  FilterWorkspace& ws = workspace_;
+  const StepInput in{terms, qd, f_des, d->barriers};
   if (ok) {
-    EvaluateBarriers(constraints_, q, qd, terms, f_des, leg_friction_nspm_, &d->barriers, &x);
-    ok = BarriersFinite(d->barriers) && (metric_ == CorrectionMetric::kForce || x.inertia_valid);
+    EvaluateBarriers(constraints_, q, qd, terms, f_des, leg_friction_nspm_, &d->barriers,
+                     &ws.barrier);
+    ok = BarriersFinite(d->barriers) &&
+         (metric_ == CorrectionMetric::kForce || ws.barrier.inertia_valid);
   }
   if (ok) {
     if (variant_ == SafetyVariant::kQpReference || variant_ == SafetyVariant::kUncomposed ||
         force_limits_) {
       // These pose the QP in y = T^-1 F, so they need T itself.
-      Matrix6d map;
-      ok = ComputeMetricMap(terms, x, &map);
+      ok = ComputeMetricMap(terms, ws.barrier, &ws.metric_map);
       if (ok && variant_ == SafetyVariant::kQpReference) {
-        SolveReference(terms, qd, x, map, d->barriers, f_des, d);
+        SolveReference(in, &ws, d);
       } else if (ok && variant_ == SafetyVariant::kUncomposed) {
-        SolveUncomposed(terms, qd, x, map, d->barriers, f_des, d);
+        SolveUncomposed(in, &ws, d);
       } else if (ok) {
-        SolveForceLimited(terms, qd, map, d->barriers, f_des, d);
+        SolveForceLimited(in, &ws, d);
       }
     } else {
-      SolveUnlimited(terms, qd, x, d->barriers, f_des, d);
+      SolveUnlimited(in, ws, d);
     }
     ok = ok && d->f_safe.allFinite();
   }
@@ -169,11 +168,12 @@ Vector6d SafetyFilter::SafeStopCommand(const Vector6d& q, const Vector6d& qd,
                                        SafetyDiagnostics* d) {
   *d = SafetyDiagnostics{};
   d->variant = variant_;
+  DynamicsTerms& terms = workspace_.terms;
   const bool state_valid = q.allFinite() && qd.allFinite();
-  if (state_valid) EvaluateDynamics(platform_, q, qd, &terms_);
+  if (state_valid) EvaluateDynamics(platform_, q, qd, &terms);
   d->filter_case = FilterCase::kFallback;
   d->flags = kFlagFallback;
-  d->f_safe = SafeStop(terms_, qd, state_valid && terms_.M.allFinite());
+  d->f_safe = SafeStop(terms, qd, state_valid && terms.M.allFinite());
   return d->f_safe;
 }
 
@@ -187,6 +187,12 @@ Vector6d SafetyFilter::SafeStop(const DynamicsTerms& terms, const Vector6d& qd,
   }
   if (force_limits_) f = f.cwiseMax(-force_limit_n_).cwiseMin(force_limit_n_);
   return f;
+}
+
+void SafetyFilter::ApplySafeStop(const StepInput& in, SafetyDiagnostics* d) const {
+  d->filter_case = FilterCase::kFallback;
+  d->flags |= kFlagFallback;
+  d->f_safe = SafeStop(in.terms, in.qd, true);
 }
 
 Matrix6d SafetyFilter::MetricMap(const DynamicsTerms& terms) const {
@@ -210,9 +216,10 @@ bool SafetyFilter::ComputeMetricMap(const DynamicsTerms& terms, const BarrierInt
   return AccelerationMetricMap(terms.H, x.inertia, map);
 }
 
-void SafetyFilter::SolveUnlimited(const DynamicsTerms& terms, const Vector6d& qd,
-                                  const BarrierIntermediates& x, const BarrierEvaluation& b,
-                                  const Vector6d& f_des, SafetyDiagnostics* d) const {
+void SafetyFilter::SolveUnlimited(const StepInput& in, const FilterWorkspace& ws,
+                                  SafetyDiagnostics* d) const {
+  const BarrierEvaluation& b = in.barriers;
+  const BarrierIntermediates& x = ws.barrier;
   // The case analysis needs the normals g~ = T^T g only through their dot
   // products. Acceleration metric, T = H^-1 L_M, g_p = -s_p H^T qd,
   // g_v = H^T M^-1 a_c: g~_p = -s_p L_M^T qd and g~_v = L_M^-1 a_c, so
@@ -231,7 +238,7 @@ void SafetyFilter::SolveUnlimited(const DynamicsTerms& terms, const Vector6d& qd
   } else {
     gram.pp = x.s_p * x.s_p * x.qd_m_qd;
     gram.vv = x.a_c.dot(x.m_inv_a_c);
-    gram.pv = -x.s_p * qd.dot(x.a_c);
+    gram.pv = -x.s_p * in.qd.dot(x.a_c);
   }
   TwoConstraintSolution s =
       variant_ == SafetyVariant::kPaperRule ? SolvePaperRule(gram) : SolveExactKkt(gram);
@@ -243,112 +250,120 @@ void SafetyFilter::SolveUnlimited(const DynamicsTerms& terms, const Vector6d& qd
   d->mu_v = s.mu_v;
   d->filter_case = s.filter_case;
   if (metric_ == CorrectionMetric::kForce) {
-    d->f_safe = f_des + s.mu_p * b.g_p + s.mu_v * b.g_v;
+    d->f_safe = in.f_des + s.mu_p * b.g_p + s.mu_v * b.g_v;
   } else if (s.mu_p == 0.0 && s.mu_v == 0.0) {
-    d->f_safe = f_des;
+    d->f_safe = in.f_des;
   } else {
     // F* - F_des = W^-1 (mu_p g_p + mu_v g_v) with W^-1 = H^-1 M H^-T:
     // H (F* - F_des) = mu_v a_c - mu_p s_p M qd, one solve with H.
     Vector6d correction = s.mu_v * x.a_c - (s.mu_p * x.s_p) * x.m_qd;
-    if (!SolvePartialPivot6(terms.H, &correction)) correction.setConstant(NAN);  // fallback
-    d->f_safe = f_des + correction;
+    if (!SolvePartialPivot6(in.terms.H, &correction)) correction.setConstant(NAN);  // fallback
+    d->f_safe = in.f_des + correction;
   }
 }
 
 bool SafetyFilter::BuildQp(const Matrix6d& map, const BarrierEvaluation& b, const Vector6d& f_des,
                            ProjectionQp* qp, QpRows* rows) const {
-  QpRows unused;
-  if (rows == nullptr) rows = &unused;
-  const bool drop_velocity = rows->drop_velocity;
-  *rows = QpRows{};
-  rows->drop_velocity = drop_velocity;
-  const TwoConstraintProblem problem = MakeProblem(constraints_, b, map, metric_);
-  qp->m = 0;
-  // y = T^-1 F; y0 = T^-1 F_des (F_des itself for the force metric).
-  qp->x0 = f_des;
-  if (metric_ != CorrectionMetric::kForce && !SolvePartialPivot6(map, &qp->x0)) {
-    qp->x0.setConstant(NAN);
-  }
-  bool posable = true;
-  auto add_cbf = [&](bool present, double psi, const Vector6d& g, int* row) {
-    if (!present) return;
-    const double norm = g.norm();
-    if (!(norm > kZeroNormal)) {
-      if (psi < 0.0) posable = false;  // no force can satisfy it
-      return;
-    }
-    // Unit normal: psi + g~^T (y - y0) >= 0  <=>  (g~/|g~|)^T y >= (g~^T y0 - psi)/|g~|.
-    qp->a.row(qp->m) = g.transpose() / norm;
-    qp->b(qp->m) = (g.dot(qp->x0) - psi) / norm;
-    *row = qp->m++;
-  };
-  add_cbf(constraints_.num_position > 0, problem.psi_p, problem.g_p, &rows->p);
-  add_cbf(constraints_.num_velocity > 0 && !rows->drop_velocity, problem.psi_v, problem.g_v,
-          &rows->v);
-  rows->box = qp->m;
-  if (force_limits_) AppendForceLimitRows(map, force_limit_n_, qp);
+  FilterWorkspace ws;  // its own: leaves the data of the filter's step alone
+  ws.metric_map = map;
+  ComposeProblem(b, &ws);
+  const bool posable = PoseQp(f_des, ConditionGroups::kAll, &ws);
+  *qp = ws.composed.qp;
+  if (rows != nullptr) *rows = ws.composed.rows;
   return posable;
 }
 
-void SafetyFilter::SolveForceLimited(const DynamicsTerms& terms, const Vector6d& qd,
-                                     const Matrix6d& map, const BarrierEvaluation& b,
-                                     const Vector6d& f_des, SafetyDiagnostics* d) const {
-  ProjectionQp qp;
-  ProjectionResult r;
-  QpRows rows;
-  r.status = ProjectionStatus::kInfeasible;
-  if (BuildQp(map, b, f_des, &qp, &rows)) r = SolveProjectionQp(qp);
-  if (r.status != ProjectionStatus::kOptimal) {
-    // Keep the position condition and the limits, relax velocity.
-    d->infeasible = true;
-    rows.drop_velocity = true;
-    r.status = ProjectionStatus::kInfeasible;
-    if (BuildQp(map, b, f_des, &qp, &rows)) r = SolveProjectionQp(qp);
-    if (r.status != ProjectionStatus::kOptimal) {
-      d->filter_case = FilterCase::kFallback;
-      d->flags |= kFlagFallback;
-      d->f_safe = SafeStop(terms, qd, true);
-      return;
-    }
+void SafetyFilter::ComposeProblem(const BarrierEvaluation& b, FilterWorkspace* ws) const {
+  ws->problem = MakeProblem(constraints_, b, ws->metric_map, metric_);
+}
+
+bool SafetyFilter::PoseQp(const Vector6d& f_des, ConditionGroups groups,
+                          FilterWorkspace* ws) const {
+  const TwoConstraintProblem& problem = ws->problem;
+  ProjectionQp& qp = ws->composed.qp;
+  QpRows& rows = ws->composed.rows;
+  rows = QpRows{};
+  qp.m = 0;
+  // y = T^-1 F; y0 = T^-1 F_des (F_des itself for the force metric).
+  qp.x0 = f_des;
+  if (metric_ != CorrectionMetric::kForce && !SolvePartialPivot6(ws->metric_map, &qp.x0)) {
+    qp.x0.setConstant(NAN);
   }
-  // Map the multipliers of the unit-normal rows back to the conditions' own.
-  // The rows hold g~/|g~| (BuildQp), so mu = mu_row / |g~|.
-  const TwoConstraintProblem problem = MakeProblem(constraints_, b, map, metric_);
-  if (rows.p >= 0) d->mu_p = r.mu(rows.p) / problem.g_p.norm();
-  if (rows.v >= 0) d->mu_v = r.mu(rows.v) / problem.g_v.norm();
-  if (force_limits_) {
+  bool posable = true;
+  if (problem.has_p) {
+    const ConditionRow r = AppendConditionRow(problem.psi_p, problem.g_p, &qp);
+    posable = posable && r.posable;
+    rows.p = r.row;
+    rows.p_norm = r.norm;
+  }
+  if (problem.has_v && groups != ConditionGroups::kPositionOnly) {
+    const ConditionRow r = AppendConditionRow(problem.psi_v, problem.g_v, &qp);
+    posable = posable && r.posable;
+    rows.v = r.row;
+    rows.v_norm = r.norm;
+  }
+  rows.box = qp.m;
+  if (force_limits_) AppendForceLimitRows(ws->metric_map, force_limit_n_, &qp);
+  return posable;
+}
+
+void SafetyFilter::ReportQpSolution(const double* force_limit_mu, SafetyDiagnostics* d) {
+  if (force_limit_mu != nullptr) {
     for (int i = 0; i < kNumLegs; ++i) {
-      d->mu_force(i) = r.mu(rows.box + 2 * i + 1) - r.mu(rows.box + 2 * i);
+      d->mu_force(i) = force_limit_mu[2 * i + 1] - force_limit_mu[2 * i];
     }
     if ((d->mu_force.array() != 0.0).any()) d->flags |= kFlagForceLimited;
   }
-  d->f_safe = ForceFromQpSolution(map, r.x, qp.x0, f_des);
   d->filter_case = d->infeasible ? FilterCase::kInfeasible : CaseFromMultipliers(d->mu_p, d->mu_v);
 }
 
-void SafetyFilter::SolveReference(const DynamicsTerms& terms, const Vector6d& qd,
-                                  const BarrierIntermediates& x, const Matrix6d& map,
-                                  const BarrierEvaluation& b, const Vector6d& f_des,
+void SafetyFilter::SolveForceLimited(const StepInput& in, FilterWorkspace* ws,
+                                     SafetyDiagnostics* d) const {
+  ComposeProblem(in.barriers, ws);
+  const ProjectionQp& qp = ws->composed.qp;
+  const QpRows& rows = ws->composed.rows;
+  ProjectionResult& r = ws->composed.result;
+  r.status = ProjectionStatus::kInfeasible;
+  if (PoseQp(in.f_des, ConditionGroups::kAll, ws)) r = SolveProjectionQp(qp);
+  if (r.status != ProjectionStatus::kOptimal) {
+    // Keep the position condition and the limits, relax velocity.
+    d->infeasible = true;
+    r.status = ProjectionStatus::kInfeasible;
+    if (PoseQp(in.f_des, ConditionGroups::kPositionOnly, ws)) r = SolveProjectionQp(qp);
+    if (r.status != ProjectionStatus::kOptimal) {
+      ApplySafeStop(in, d);
+      return;
+    }
+  }
+  d->mu_p = ConditionMultiplier(r.mu.data(), rows.p, rows.p_norm);
+  d->mu_v = ConditionMultiplier(r.mu.data(), rows.v, rows.v_norm);
+  d->f_safe = ForceFromQpSolution(ws->metric_map, r.x, qp.x0, in.f_des);
+  ReportQpSolution(force_limits_ ? r.mu.data() + rows.box : nullptr, d);
+}
+
+void SafetyFilter::SolveReference(const StepInput& in, FilterWorkspace* ws,
                                   SafetyDiagnostics* d) const {
-  ProjectionQp qp;
-  Vector6d y = f_des;
-  const bool posable = BuildQp(map, b, f_des, &qp);
+  ComposeProblem(in.barriers, ws);
+  const ProjectionQp& qp = ws->composed.qp;
+  Vector6d& y = ws->composed.result.x;
+  y = in.f_des;
+  const bool posable = PoseQp(in.f_des, ConditionGroups::kAll, ws);
   if (!posable || reference_->Solve(qp, &y) != ProjectionStatus::kOptimal) {
     // The reference has no answer: the closed form's documented fallback.
-    SolveUnlimited(terms, qd, x, b, f_des, d);
+    SolveUnlimited(in, *ws, d);
     d->infeasible = true;
     d->filter_case = FilterCase::kInfeasible;
     return;
   }
   // Multipliers from stationarity, y - y0 = mu_p g~_p + mu_v g~_v (least squares).
-  const TwoConstraintProblem problem = MakeProblem(constraints_, b, map, metric_);
+  const TwoConstraintProblem& problem = ws->problem;
   Eigen::Matrix<double, 6, 2> g;
   g << problem.g_p, problem.g_v;
   const Eigen::Vector2d mu = g.colPivHouseholderQr().solve(y - qp.x0);
   d->mu_p = mu.allFinite() ? std::fmax(mu(0), 0.0) : 0.0;
   d->mu_v = mu.allFinite() ? std::fmax(mu(1), 0.0) : 0.0;
-  d->filter_case = CaseFromMultipliers(d->mu_p, d->mu_v);
-  d->f_safe = ForceFromQpSolution(map, y);
+  d->f_safe = ForceFromQpSolution(ws->metric_map, y);
+  ReportQpSolution(nullptr, d);  // the reference solver gives no row multipliers
 }
 
 }  // namespace stewart::safety

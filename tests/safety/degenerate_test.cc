@@ -18,12 +18,10 @@ TEST(Degenerate, AtRestThePositionNormalIsZeroAndOnlyVelocityActs) {
   // one axis at rest, their LSE weights are equal and their rates cancel
   // (docs/safety.md), so the condition would not act at this instant.
   SafetyFilter filter(DefaultConfig().platform, DefaultConfig().safety, DefaultConfig().actuators);
-  const Vector6d q = DefaultConfig().home_pose;
-  const DynamicsTerms t = EvaluateDynamics(DefaultConfig().platform, q, Vector6d::Zero());
   // Accelerates along +x: the (then smallest-margin) xd limit must act.
-  const Vector6d f_des = InverseDynamics(t, Vector6d::Unit(0) * 20.0);
+  const auto [q, qd, f_des, t] = AtRestPushedAlongX(20.0);
   SafetyDiagnostics d;
-  const Vector6d f = filter.Step(q, Vector6d::Zero(), f_des, &d);
+  const Vector6d f = filter.Step(q, qd, f_des, &d);
   EXPECT_TRUE(f.allFinite());
   EXPECT_EQ(d.barriers.g_p, Vector6d::Zero());
   EXPECT_GT(d.barriers.h_pos, 0.0);

@@ -18,11 +18,7 @@ void CheckKkt(bool force_limits, CorrectionMetric metric) {
   std::mt19937 rng(force_limits ? 23 : 29);
   int checked = 0, active = 0;
   for (int n = 0; n < 5000; ++n) {
-    const FilterInput x = RandomFilterInput(&rng);
-    const Vector6d& q = x.q;
-    const Vector6d& qd = x.qd;
-    const DynamicsTerms& terms = x.terms;
-    const Vector6d& f_des = x.f_des;
+    const auto [q, qd, f_des, terms] = RandomFilterInput(&rng);
     SafetyDiagnostics d;
     const Vector6d f = filter.StepWithTerms(terms, q, qd, f_des, &d);
     ASSERT_TRUE(f.allFinite());

@@ -17,9 +17,9 @@ namespace {
 
 constexpr int kSamples = 100000;
 constexpr double kRelTol = 1e-9;
-// Clp reaches the same 1e-9 once its automatic scaling is off and its
-// tolerances are 1e-12 (ClpReferenceQp; with scaling on it returned optima
-// off by up to 50 % in the acceleration metric's coordinates).
+// Clp reaches the same 1e-9 with its automatic scaling off and its
+// tolerances at 1e-12 (ClpReferenceQp; with scaling on, its optima are off
+// by up to 50 % in the acceleration metric's coordinates).
 constexpr double kClpRelTol = 1e-9;
 
 void Sweep(ReferenceQpSolver* reference, bool force_limits, CorrectionMetric metric, int samples,
@@ -35,11 +35,7 @@ void Sweep(ReferenceQpSolver* reference, bool force_limits, CorrectionMetric met
   int paper_differs = 0, both_infeasible = 0;
   double worst = 0.0;
   for (int n = 0; n < samples; ++n) {
-    const FilterInput x = RandomFilterInput(&rng);
-    const Vector6d& q = x.q;
-    const Vector6d& qd = x.qd;
-    const DynamicsTerms& terms = x.terms;
-    const Vector6d& f_des = x.f_des;
+    const auto [q, qd, f_des, terms] = RandomFilterInput(&rng);
     SafetyDiagnostics d;
     const Vector6d f = filter.StepWithTerms(terms, q, qd, f_des, &d);
     ++cases[static_cast<size_t>(d.filter_case)];

@@ -114,6 +114,15 @@ FilterInput RandomFilterInput(std::mt19937* rng) {
   return x;
 }
 
+FilterInput AtRestPushedAlongX(double accel_mps2) {
+  FilterInput x;
+  x.q = DefaultConfig().home_pose;
+  x.qd = Vector6d::Zero();
+  x.terms = EvaluateDynamics(DefaultConfig().platform, x.q, x.qd);
+  x.f_des = InverseDynamics(x.terms, Vector6d::Unit(0) * accel_mps2);
+  return x;
+}
+
 Vector6d HoverForce(const Vector6d& q) {
   const DynamicsTerms t = EvaluateDynamics(DefaultConfig().platform, q, Vector6d::Zero());
   return t.H.partialPivLu().solve(t.G);

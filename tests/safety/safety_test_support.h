@@ -40,6 +40,10 @@ struct FilterInput {
 /// RandomPoseInLimits, RandomVelocity, the terms there, RandomNominalForce.
 FilterInput RandomFilterInput(std::mt19937* rng);
 
+/// At rest at the home pose, with the nominal force that accelerates along +x
+/// by `accel_mps2` (inverse dynamics).
+FilterInput AtRestPushedAlongX(double accel_mps2);
+
 /// The leg forces that hold the platform at rest at q (H F = G).
 Vector6d HoverForce(const Vector6d& q);
 

@@ -4,6 +4,7 @@
 // The comparison with Clp is uncomposed_reference_test.cc.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -19,6 +20,49 @@ SafetyConfig UncomposedConfig(bool force_limits, CorrectionMetric metric) {
   s.force_limits_enabled = force_limits;
   s.correction_metric = metric;
   return s;
+}
+
+// Sums over the single-barrier rows for the stationarity check.
+struct Stationarity {
+  Vector6d sum_mu_n = Vector6d::Zero();
+  double sum_abs_mu_n = 0.0;  // rounding in the stationarity residual grows with it
+  int active = 0;             ///< rows of the last group checked with mu > 0
+};
+
+// One group's single-barrier conditions (position or velocity) at F_des and F*.
+template <typename Spec, size_t N>
+struct GroupKkt {
+  int count;
+  const std::array<double, N>& mu;
+  const std::array<double, N>& psi_des;
+  const std::array<double, N>& psi_f;
+  const std::array<Vector6d, N>& n_des;
+  const std::array<Spec, N>& specs;
+  double scale;
+  double tol_floor;  ///< inside the tolerance's parentheses
+};
+
+// Dual and primal feasibility and complementary slackness of each barrier of
+// the group; adds its rows to the stationarity sums and returns sum_i mu_i.
+template <typename Spec, size_t N>
+double CheckGroupKkt(const GroupKkt<Spec, N>& g, int n, Stationarity* sums) {
+  double mu_sum = 0.0;
+  sums->active = 0;
+  for (int i = 0; i < g.count; ++i) {
+    const size_t k = static_cast<size_t>(i);
+    const double mu = g.mu[k];
+    const double tol =
+        1e-10 * (std::fabs(g.psi_des[k]) + g.n_des[k].norm() * g.scale + g.tol_floor);
+    EXPECT_GE(mu, 0.0) << "sample " << n;
+    // Every single-barrier condition holds at F*, and only tight ones push.
+    EXPECT_GE(g.psi_f[k], -tol) << "sample " << n << " " << g.specs[k].name;
+    EXPECT_LE(std::fabs(mu * g.psi_f[k]), mu * tol + 1e-300) << "sample " << n;
+    sums->sum_mu_n += mu * g.n_des[k];
+    sums->sum_abs_mu_n += mu * g.n_des[k].norm();
+    mu_sum += mu;
+    sums->active += mu > 0.0 ? 1 : 0;
+  }
+  return mu_sum;
 }
 
 // KKT of min (F - F_des)^T W (F - F_des) s.t. Psi_i(F) >= 0 for every barrier
@@ -41,10 +85,7 @@ void CheckKkt(bool force_limits, CorrectionMetric metric, double position_margin
     if (n % 4 != 3 || !DrawNearPositionLimit(filter, n % 8 == 3 ? 1e-5 : 2e-3, &rng, &x)) {
       x = RandomFilterInput(&rng);
     }
-    const Vector6d& q = x.q;
-    const Vector6d& qd = x.qd;
-    const DynamicsTerms& terms = x.terms;
-    const Vector6d& f_des = x.f_des;
+    const auto& [q, qd, f_des, terms] = x;
     SafetyDiagnostics d;
     const Vector6d f = filter.StepWithTerms(terms, q, qd, f_des, &d);
     ASSERT_TRUE(f.allFinite());
@@ -55,38 +96,20 @@ void CheckKkt(bool force_limits, CorrectionMetric metric, double position_margin
         EvaluateSingleBarrierConditions(filter, q, qd, terms, f_des);
     const SingleBarrierConditions at_f = EvaluateSingleBarrierConditions(filter, q, qd, terms, f);
     const double scale = f.norm() + f_des.norm() + 1.0;
-    Vector6d sum_mu_n = Vector6d::Zero();
-    double sum_abs_mu_n = 0.0;  // rounding in the stationarity residual grows with it
-    double mu_p = 0.0, mu_v = 0.0;
-    int velocity_active = 0;
-    for (int i = 0; i < at_f.num_position; ++i) {
-      const size_t k = static_cast<size_t>(i);
-      const double mu = d.mu_position[k];
-      const double tol =
-          1e-10 * (std::fabs(at_des.psi_position[k]) + at_des.n_position[k].norm() * scale + 1e-12);
-      EXPECT_GE(mu, 0.0) << "sample " << n;
-      // Every single-barrier condition holds at F*, and only tight ones push.
-      EXPECT_GE(at_f.psi_position[k], -tol)
-          << "sample " << n << " " << filter.constraints().position[k].name;
-      EXPECT_LE(std::fabs(mu * at_f.psi_position[k]), mu * tol + 1e-300) << "sample " << n;
-      sum_mu_n += mu * at_des.n_position[k];
-      sum_abs_mu_n += mu * at_des.n_position[k].norm();
-      mu_p += mu;
-    }
-    for (int i = 0; i < at_f.num_velocity; ++i) {
-      const size_t k = static_cast<size_t>(i);
-      const double mu = d.mu_velocity[k];
-      const double tol =
-          1e-10 * (std::fabs(at_des.psi_velocity[k]) + at_des.n_velocity[k].norm() * scale);
-      EXPECT_GE(mu, 0.0) << "sample " << n;
-      EXPECT_GE(at_f.psi_velocity[k], -tol)
-          << "sample " << n << " " << filter.constraints().velocity[k].name;
-      EXPECT_LE(std::fabs(mu * at_f.psi_velocity[k]), mu * tol + 1e-300) << "sample " << n;
-      sum_mu_n += mu * at_des.n_velocity[k];
-      sum_abs_mu_n += mu * at_des.n_velocity[k].norm();
-      mu_v += mu;
-      velocity_active += mu > 0.0 ? 1 : 0;
-    }
+    Stationarity sums;
+    const double mu_p = CheckGroupKkt(
+        GroupKkt<PositionBarrierSpec, kMaxPositionBarriers>{
+            at_f.num_position, d.mu_position, at_des.psi_position, at_f.psi_position,
+            at_des.n_position, filter.constraints().position, scale, 1e-12},
+        n, &sums);
+    const double mu_v = CheckGroupKkt(
+        GroupKkt<VelocityBarrierSpec, kMaxVelocityBarriers>{
+            at_f.num_velocity, d.mu_velocity, at_des.psi_velocity, at_f.psi_velocity,
+            at_des.n_velocity, filter.constraints().velocity, scale, 0.0},
+        n, &sums);
+    const Vector6d& sum_mu_n = sums.sum_mu_n;
+    const double sum_abs_mu_n = sums.sum_abs_mu_n;
+    const int velocity_active = sums.active;
     if (velocity_active > 1) ++multi_velocity;
     // The diagnostics' group multipliers are the sums of the rows'.
     EXPECT_NEAR(d.mu_p, mu_p, 1e-12 * mu_p);
@@ -230,11 +253,9 @@ TEST(Uncomposed, AgreesWithTheComposedFilterAsKGrows) {
 TEST(UncomposedDegenerate, AtRestOnlyVelocityRowsAct) {
   // qd = 0: every position row has a zero normal (left out, all met inside).
   SafetyFilter filter = MakeRichFilter(false, SafetyVariant::kUncomposed);
-  const Vector6d q = DefaultConfig().home_pose;
-  const DynamicsTerms t = EvaluateDynamics(DefaultConfig().platform, q, Vector6d::Zero());
-  const Vector6d f_des = InverseDynamics(t, Vector6d::Unit(0) * 20.0);
+  const auto [q, qd, f_des, t] = AtRestPushedAlongX(20.0);
   SafetyDiagnostics d;
-  const Vector6d f = filter.Step(q, Vector6d::Zero(), f_des, &d);
+  const Vector6d f = filter.Step(q, qd, f_des, &d);
   EXPECT_TRUE(f.allFinite());
   EXPECT_FALSE(d.infeasible);
   EXPECT_EQ(d.filter_case, FilterCase::kVelocity);
@@ -290,11 +311,7 @@ TEST(UncomposedDegenerate, EmptyVelocitySlabKeepsThePositionRows) {
   SafetyFilter filter(DefaultConfig().platform, config, DefaultConfig().actuators);
   std::mt19937 rng(47);
   for (int n = 0; n < 200; ++n) {
-    const FilterInput x = RandomFilterInput(&rng);
-    const Vector6d& q = x.q;
-    const Vector6d& qd = x.qd;
-    const DynamicsTerms& terms = x.terms;
-    const Vector6d& f_des = x.f_des;
+    const auto [q, qd, f_des, terms] = RandomFilterInput(&rng);
     SafetyDiagnostics d;
     const Vector6d f = filter.StepWithTerms(terms, q, qd, f_des, &d);
     ASSERT_TRUE(f.allFinite());

@@ -52,8 +52,9 @@ struct ConstraintSet {
   double velocity_margin = 0.0;
 };
 
-/// Throws std::invalid_argument when the config holds more constraints than
-/// the capacity (an axis listed twice) or non-positive gains.
+/// Throws InputError (a std::invalid_argument naming the config key) when the
+/// config holds more constraints than the capacity (an axis listed twice) or
+/// non-positive gains.
 ConstraintSet BuildConstraintSet(const PlatformParams& platform, const SafetyConfig& safety);
 
 }  // namespace stewart::safety

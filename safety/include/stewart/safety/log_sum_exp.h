@@ -10,9 +10,9 @@
 
 namespace stewart::safety {
 
-/// `alpha_h[i]` = alpha_i h_i for i < n (n >= 1), `k` > 0. Writes the weights
-/// w_i to `weights` and returns h_c. Non-finite input gives a non-finite h_c
-/// (the caller rejects it).
+/// `alpha_h[i]` = alpha_i h_i for i < n, `k` > 0; n >= 1 (checked: throws
+/// std::logic_error). Writes the weights w_i to `weights` and returns h_c.
+/// Non-finite input gives a non-finite h_c (the caller rejects it).
 double ComposeLogSumExp(const double* alpha_h, int n, double k, double* weights);
 
 }  // namespace stewart::safety

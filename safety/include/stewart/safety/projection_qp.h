@@ -20,6 +20,7 @@
 // for those two capacities in projection_qp.cc.
 #include <array>
 
+#include "stewart/common/check.h"
 #include "stewart/model/types.h"
 
 namespace stewart::safety {
@@ -54,10 +55,43 @@ ProjectionResultN<MaxRows> SolveProjectionQp(const ProjectionQpN<MaxRows>& qp);
 
 extern template ProjectionResultN<kMaxQpRows> SolveProjectionQp(const ProjectionQpN<kMaxQpRows>&);
 
+/// A normal shorter than this (W/N = m/s for g_p) counts as zero: the
+/// condition cannot be changed by the force (e.g. g_p = -H^T qd at rest).
+constexpr double kZeroNormal = 1e-12;
+
+/// Where AppendConditionRow put a condition.
+struct ConditionRow {
+  int row = -1;         ///< -1: not posed (zero normal)
+  double norm = 0.0;    ///< |n| of a posed row: its multiplier is the row's / |n|
+  bool posable = true;  ///< false: a zero normal and a violated condition
+};
+
+/// Appends psi + n^T (x - x0) >= 0 (x0 = qp->x0) as the unit-normal row
+/// (n/|n|)^T x >= (n^T x0 - psi)/|n|, so that the solver's row multipliers
+/// compare across conditions of different units. A zero normal poses no row:
+/// the force cannot change the condition, which then either holds or makes
+/// the QP unposable (no force can satisfy it).
+template <int MaxRows>
+ConditionRow AppendConditionRow(double psi, const Vector6d& normal, ProjectionQpN<MaxRows>* qp) {
+  ConditionRow r;
+  const double norm = normal.norm();
+  if (!(norm > kZeroNormal)) {
+    r.posable = !(psi < 0.0);
+    return r;
+  }
+  STEWART_CHECK(qp->m < MaxRows, "AppendConditionRow: the QP has no row left");
+  qp->a.row(qp->m) = normal.transpose() / norm;
+  qp->b(qp->m) = (normal.dot(qp->x0) - psi) / norm;
+  r.norm = norm;
+  r.row = qp->m++;
+  return r;
+}
+
 /// Appends the force-limit rows |F_i| <= f_max_n of F = T y (T = metric_map,
 /// docs/safety.md): per leg i, T_i y >= -f_max_n then -T_i y >= -f_max_n.
 template <int MaxRows>
 void AppendForceLimitRows(const Matrix6d& metric_map, double f_max_n, ProjectionQpN<MaxRows>* qp) {
+  STEWART_CHECK(qp->m + 2 * kNumLegs <= MaxRows, "AppendForceLimitRows: too few rows left");
   for (int i = 0; i < kNumLegs; ++i) {
     qp->a.row(qp->m) = metric_map.row(i);
     qp->b(qp->m++) = -f_max_n;

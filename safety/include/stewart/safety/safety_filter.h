@@ -17,6 +17,7 @@
 #include "stewart/model/dynamics.h"
 #include "stewart/safety/constraint_set.h"
 #include "stewart/safety/diagnostics.h"
+#include "stewart/safety/filter_workspace.h"
 #include "stewart/safety/reference_qp.h"
 #include "stewart/safety/uncomposed_qp.h"
 
@@ -27,8 +28,9 @@ constexpr double kMaxInputForceN = 1e7;
 
 class SafetyFilter {
  public:
-  /// Throws std::invalid_argument for an unusable config, or variant "qp"
-  /// without a reference solver (which must outlive the filter).
+  /// Throws InputError (a std::invalid_argument naming the config key) for an
+  /// unusable config, or variant "qp" without a reference solver (which must
+  /// outlive the filter).
   SafetyFilter(const PlatformParams& platform, const SafetyConfig& safety,
                const ActuatorConfig& actuators, ReferenceQpSolver* reference = nullptr);
 
@@ -39,8 +41,8 @@ class SafetyFilter {
                 SafetyDiagnostics* diagnostics);
 
   /// The filter given the model terms at (q, qd) (from EvaluateDynamics).
-  /// Not timed: diagnostics->compute_ns is set to 0 (Step times the step;
-  /// a clock read costs ~10 % of this call).
+  /// Not timed: diagnostics->compute_ns is set to 0 (Step times the step,
+  /// and a clock read is not negligible against this call: docs/performance.md).
   Vector6d StepWithTerms(const DynamicsTerms& terms, const Vector6d& q, const Vector6d& qd,
                          const Vector6d& f_des, SafetyDiagnostics* diagnostics) const;
 
@@ -65,11 +67,7 @@ class SafetyFilter {
   /// solution back with ForceFromQpSolution.
   /// Absent rows are left out; returns false when a CBF row has a zero
   /// normal (it cannot be posed).
-  struct QpRows {
-    int p = -1, v = -1;          ///< row of each CBF condition, -1 if left out
-    int box = 0;                 ///< first force-limit row (lower, upper per leg)
-    bool drop_velocity = false;  ///< in: leave the velocity condition out
-  };
+  using QpRows = safety::QpRows;
   bool BuildQp(const Matrix6d& metric_map, const BarrierEvaluation& barriers, const Vector6d& f_des,
                ProjectionQp* qp, QpRows* rows = nullptr) const;
 
@@ -107,25 +105,39 @@ class SafetyFilter {
   double force_limit_n() const { return force_limit_n_; }
 
  private:
+  /// The inputs of one step, as the private steps read them.
+  struct StepInput {
+    const DynamicsTerms& terms;
+    const Vector6d& qd;
+    const Vector6d& f_des;
+    const BarrierEvaluation& barriers;
+  };
+
   Vector6d SafeStop(const DynamicsTerms& terms, const Vector6d& qd, bool terms_valid) const;
+  /// The safe stop as the answer of a step whose QP has no solution.
+  void ApplySafeStop(const StepInput& in, SafetyDiagnostics* d) const;
   bool ComputeMetricMap(const DynamicsTerms& terms, const BarrierIntermediates& x,
                         Matrix6d* map) const;
-  void SolveUnlimited(const DynamicsTerms& terms, const Vector6d& qd, const BarrierIntermediates& x,
-                      const BarrierEvaluation& b, const Vector6d& f_des,
-                      SafetyDiagnostics* d) const;
-  void SolveForceLimited(const DynamicsTerms& terms, const Vector6d& qd, const Matrix6d& map,
-                         const BarrierEvaluation& b, const Vector6d& f_des,
-                         SafetyDiagnostics* d) const;
-  void SolveReference(const DynamicsTerms& terms, const Vector6d& qd, const BarrierIntermediates& x,
-                      const Matrix6d& map, const BarrierEvaluation& b, const Vector6d& f_des,
-                      SafetyDiagnostics* d) const;
-  bool BuildUncomposedQp(const DynamicsTerms& terms, const Vector6d& qd, const Cholesky6& inertia,
-                         const Matrix6d& map, const BarrierEvaluation& b, const Vector6d& f_des,
-                         UncomposedQp* qp, UncomposedQpRows* rows) const;
-  void SolveUncomposed(const DynamicsTerms& terms, const Vector6d& qd,
-                       const BarrierIntermediates& x, const Matrix6d& map,
-                       const BarrierEvaluation& b, const Vector6d& f_des,
-                       SafetyDiagnostics* d) const;
+  void SolveUnlimited(const StepInput& in, const FilterWorkspace& ws, SafetyDiagnostics* d) const;
+  /// ws->problem from the barriers and ws->metric_map.
+  void ComposeProblem(const BarrierEvaluation& b, FilterWorkspace* ws) const;
+  /// ws->composed.qp and .rows from ws->problem and ws->metric_map.
+  bool PoseQp(const Vector6d& f_des, ConditionGroups groups, FilterWorkspace* ws) const;
+  void SolveForceLimited(const StepInput& in, FilterWorkspace* ws, SafetyDiagnostics* d) const;
+  void SolveReference(const StepInput& in, FilterWorkspace* ws, SafetyDiagnostics* d) const;
+  /// `out` posed from ws.barrier.inertia and ws.metric_map.
+  bool PoseUncomposedQp(const StepInput& in, ConditionGroups groups, const FilterWorkspace& ws,
+                        UncomposedQpData* out) const;
+  void SolveUncomposed(const StepInput& in, FilterWorkspace* ws, SafetyDiagnostics* d) const;
+  /// The report of a QP solution, for every variant that solves one: from the
+  /// group multipliers d->mu_p, d->mu_v, the case; from the force-limit rows'
+  /// multipliers (lower, upper per leg; nullptr when none were posed or the
+  /// solver gives none), d->mu_force and kFlagForceLimited.
+  static void ReportQpSolution(const double* force_limit_mu, SafetyDiagnostics* d);
+  /// The multiplier of a condition posed as a unit-normal row (`row` -1: not posed).
+  static double ConditionMultiplier(const double* row_mu, int row, double norm) {
+    return row >= 0 ? row_mu[row] / norm : 0.0;
+  }
 
   PlatformParams platform_;
   ConstraintSet constraints_;
@@ -137,7 +149,11 @@ class SafetyFilter {
   SafetyFallback fallback_;
   double stop_time_s_;
   ReferenceQpSolver* reference_;
-  DynamicsTerms terms_;  // scratch for Step
+  /// The data of the step under way (filter_workspace.h): written by every
+  /// step before it is read, so a const step changes nothing observable.
+  /// Like the model terms it holds, it makes a filter one step at a time:
+  /// not to be stepped from two threads at once.
+  mutable FilterWorkspace workspace_;
 };
 
 }  // namespace stewart::safety

@@ -12,6 +12,7 @@
 #include "stewart/common/enum_table.h"
 
 #include "stewart/model/types.h"
+#include "stewart/safety/projection_qp.h"  // kZeroNormal
 
 namespace stewart::safety {
 
@@ -62,9 +63,6 @@ struct TwoConstraintSolution {
   bool feasible = true;
 };
 
-/// A normal shorter than this (W/N = m/s for g_p) counts as zero: the
-/// condition cannot be changed by the force (e.g. g_p = -H^T qd at rest).
-constexpr double kZeroNormal = 1e-12;
 /// Gram determinant below this fraction of |g_p|^2 |g_v|^2 (sin^2 of the
 /// angle between the normals) counts as parallel normals.
 constexpr double kParallelSin2 = 1e-12;

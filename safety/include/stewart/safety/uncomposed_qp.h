@@ -33,8 +33,6 @@ extern template ProjectionResultN<kMaxUncomposedQpRows> SolveProjectionQp(
 
 /// Which QP row holds which barrier (SafetyFilter::BuildUncomposedQp).
 struct UncomposedQpRows {
-  bool drop_position = false;  ///< in: leave every position row out
-  bool drop_velocity = false;  ///< in: leave every velocity row out
   /// Row of barrier i, -1 when left out (dropped, or a zero normal: then the
   /// condition does not depend on F and is either met or makes the QP
   /// unposable).
