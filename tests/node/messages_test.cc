@@ -4,6 +4,7 @@
 
 #include <vector>
 
+#include "stewart/test_support/lcm_messages.h"
 #include "stewart/force_command_t.hpp"
 #include "stewart/health_t.hpp"
 #include "stewart/safety_diagnostics_t.hpp"
@@ -78,18 +79,8 @@ TEST(Messages, StateSetpointCommandRoundTrip) {
 TEST(Messages, VariableLengthDiagnosticsAndHealth) {
   safety_diagnostics_t d{};
   d.utime = 100;
-  d.num_position = 2;
-  d.position_names = {"x_upper", "leg3_max"};
-  d.h_position = {1e-3, 2e-3};
-  d.alpha_h_position = {1e-3, 4e-3};
-  d.w_position = {0.75, 0.25};
-  d.mu_position = {0.0, 0.0};
-  d.num_velocity = 1;
-  d.velocity_names = {"zd_upper"};
-  d.h_velocity = {0.01};
-  d.alpha_h_velocity = {0.02};
-  d.w_velocity = {1.0};
-  d.mu_velocity = {0.0};
+  test::SetGroups({{"x_upper", "leg3_max"}, {1e-3, 2e-3}, {1e-3, 4e-3}, {0.75, 0.25}, {0.0, 0.0}},
+                  {{"zd_upper"}, {0.01}, {0.02}, {1.0}, {0.0}}, &d);
   d.active_case = safety_diagnostics_t::CASE_BOTH;
   d.compute_ns = 250;
   const safety_diagnostics_t d2 = RoundTrip(d);

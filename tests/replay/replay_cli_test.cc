@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "stewart/test_support/lcm_messages.h"
 #include "stewart/config/scenario_loader.h"
 #include "stewart/config/config_loader.h"
 #include "stewart/controller/controller.h"
@@ -54,17 +55,6 @@ nlohmann::json ReadJson(const std::string& path) {
   return nlohmann::json::parse(in);
 }
 
-template <typename Msg>
-void Append(lcm::LogFile* log, const std::string& channel, const Msg& msg, int64_t timestamp) {
-  std::vector<uint8_t> buffer(static_cast<size_t>(msg.getEncodedSize()));
-  msg.encode(buffer.data(), 0, static_cast<int>(buffer.size()));
-  lcm::LogEvent event{};
-  event.timestamp = timestamp;
-  event.channel = channel;
-  event.datalen = static_cast<int32_t>(buffer.size());
-  event.data = buffer.data();
-  ASSERT_EQ(log->writeEvent(&event), 0);
-}
 
 constexpr int kSamples = 200;
 constexpr int kInitializing = 5;   // first samples: estimator initialising -> node fallback
@@ -122,7 +112,7 @@ class ReplayCli : public ::testing::Test {
       std::copy(qd, qd + 6, state.qd);
       state.status = k < kInitializing ? int32_t{state_t::STATUS_INITIALIZING}
                                        : int32_t{state_t::STATUS_VALID};
-      if (!dropped) Append(&log, ch.state_estimate, state, timestamp++);
+      if (!dropped) test::AppendToLog(&log, ch.state_estimate, state, timestamp++);
 
       force_command_t nominal{};
       nominal.utime = nominal.sample_utime = utime;
@@ -147,10 +137,10 @@ class ReplayCli : public ::testing::Test {
       diag.utime = diag.sample_utime = utime;
       diag.seq = k;
       if (dropped) continue;
-      if (k == kStaleSample) Append(&log, ch.command_safe, safe, timestamp++);
-      if (k >= kInitializing) Append(&log, ch.command_nominal, nominal, timestamp++);
-      if (k != kStaleSample) Append(&log, ch.command_safe, safe, timestamp++);
-      Append(&log, ch.safety_diagnostics, diag, timestamp++);
+      if (k == kStaleSample) test::AppendToLog(&log, ch.command_safe, safe, timestamp++);
+      if (k >= kInitializing) test::AppendToLog(&log, ch.command_nominal, nominal, timestamp++);
+      if (k != kStaleSample) test::AppendToLog(&log, ch.command_safe, safe, timestamp++);
+      test::AppendToLog(&log, ch.safety_diagnostics, diag, timestamp++);
     }
     return run;
   }
@@ -196,8 +186,8 @@ TEST_F(ReplayCli, ControllerClockRecoveredWhenTheLogLacksTheStart) {
       nominal.seq = k;
       for (int i = 0; i < 6; ++i) nominal.force_n[i] = out.force_n(i);
       if (k < kLost) continue;
-      Append(&log, config.lcm.channels.state_estimate, state, 1000 + k);
-      Append(&log, config.lcm.channels.command_nominal, nominal, 1000 + k);
+      test::AppendToLog(&log, config.lcm.channels.state_estimate, state, 1000 + k);
+      test::AppendToLog(&log, config.lcm.channels.command_nominal, nominal, 1000 + k);
     }
   }
   const std::string json_path = root_ + "/replay.json";

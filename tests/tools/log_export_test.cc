@@ -13,21 +13,11 @@
 #include "stewart/force_command_t.hpp"
 #include "stewart/safety_diagnostics_t.hpp"
 #include "stewart/state_t.hpp"
+#include "stewart/test_support/lcm_messages.h"
 
 namespace stewart {
 namespace {
 
-template <typename Msg>
-void Append(lcm::LogFile* log, const std::string& channel, const Msg& msg, int64_t timestamp) {
-  std::vector<uint8_t> buffer(static_cast<size_t>(msg.getEncodedSize()));
-  msg.encode(buffer.data(), 0, static_cast<int>(buffer.size()));
-  lcm::LogEvent event{};
-  event.timestamp = timestamp;
-  event.channel = channel;
-  event.datalen = static_cast<int32_t>(buffer.size());
-  event.data = buffer.data();
-  ASSERT_EQ(log->writeEvent(&event), 0);
-}
 
 std::vector<std::string> Lines(const std::string& path) {
   std::ifstream in(path);
@@ -48,30 +38,20 @@ TEST(LogExport, OneCsvPerChannel) {
       s.seq = k;
       s.sample_utime = 1000 * k;
       s.q[2] = 0.4 + 0.001 * k;
-      Append(&log, "T_STATE", s, 50 + k);
+      test::AppendToLog(&log, "T_STATE", s, 50 + k);
       force_command_t f{};
       f.utime = 1000 * k;
       f.seq = k;
       f.sample_utime = 1000 * k;
       f.force_n[0] = 1.5 * k;
       f.flags = k % 2;
-      Append(&log, "T_CMD", f, 60 + k);
+      test::AppendToLog(&log, "T_CMD", f, 60 + k);
     }
     safety_diagnostics_t d{};
     d.utime = d.sample_utime = 7000;
-    d.num_position = 2;
-    d.position_names = {"x_upper", "leg0_max"};
-    d.h_position = {0.1, 0.2};
-    d.alpha_h_position = {0.1, 0.2};
-    d.w_position = {0.75, 0.25};
-    d.mu_position = {0.0, 0.0};
-    d.num_velocity = 1;
-    d.velocity_names = {"zd_upper"};
-    d.h_velocity = {0.01};
-    d.alpha_h_velocity = {0.02};
-    d.w_velocity = {1.0};
-    d.mu_velocity = {0.5};
-    Append(&log, "T_DIAG", d, 70);
+    test::SetGroups({{"x_upper", "leg0_max"}, {0.1, 0.2}, {0.1, 0.2}, {0.75, 0.25}, {0.0, 0.0}},
+                    {{"zd_upper"}, {0.01}, {0.02}, {1.0}, {0.5}}, &d);
+    test::AppendToLog(&log, "T_DIAG", d, 70);
     lcm::LogEvent junk{};
     uint8_t bytes[4] = {1, 2, 3, 4};
     junk.channel = "T_OTHER";

@@ -1,0 +1,54 @@
+#pragma once
+// Building LCM messages and logs in tests: a message appended to an LCM log
+// file as the logger would record it, and the variable-length barrier groups
+// of a safety_diagnostics_t filled in one call.
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <lcm/lcm-cpp.hpp>
+#include <string>
+#include <vector>
+
+#include "stewart/safety_diagnostics_t.hpp"
+
+namespace stewart::test {
+
+/// Encodes `msg` and appends it to `log` on `channel` at `timestamp` (us).
+template <typename Msg>
+void AppendToLog(lcm::LogFile* log, const std::string& channel, const Msg& msg,
+                 int64_t timestamp) {
+  std::vector<uint8_t> buffer(static_cast<size_t>(msg.getEncodedSize()));
+  msg.encode(buffer.data(), 0, static_cast<int>(buffer.size()));
+  lcm::LogEvent event{};
+  event.timestamp = timestamp;
+  event.channel = channel;
+  event.datalen = static_cast<int32_t>(buffer.size());
+  event.data = buffer.data();
+  ASSERT_EQ(log->writeEvent(&event), 0);
+}
+
+/// One barrier group of safety_diagnostics_t: per barrier its name, h,
+/// alpha(h), LSE weight and multiplier.
+struct DiagnosticsGroup {
+  std::vector<std::string> names;
+  std::vector<double> h, alpha_h, w, mu;
+};
+
+/// Sets both groups and their counts.
+inline void SetGroups(const DiagnosticsGroup& position, const DiagnosticsGroup& velocity,
+                      safety_diagnostics_t* d) {
+  d->num_position = static_cast<int32_t>(position.names.size());
+  d->position_names = position.names;
+  d->h_position = position.h;
+  d->alpha_h_position = position.alpha_h;
+  d->w_position = position.w;
+  d->mu_position = position.mu;
+  d->num_velocity = static_cast<int32_t>(velocity.names.size());
+  d->velocity_names = velocity.names;
+  d->h_velocity = velocity.h;
+  d->alpha_h_velocity = velocity.alpha_h;
+  d->w_velocity = velocity.w;
+  d->mu_velocity = velocity.mu;
+}
+
+}  // namespace stewart::test
