@@ -12,8 +12,8 @@ InputError::InputError(const std::string& key, const std::string& reason,
 namespace internal {
 
 void FailCheck(const char* condition, const char* file, int line, const std::string& message) {
-  throw std::logic_error(std::string(file) + ":" + std::to_string(line) + ": check '" +
-                         condition + "' failed: " + message);
+  throw std::logic_error(std::string(file) + ":" + std::to_string(line) + ": check '" + condition +
+                         "' failed: " + message);
 }
 
 }  // namespace internal

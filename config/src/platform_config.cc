@@ -9,9 +9,9 @@ PlatformParams ParsePlatformParams(const ConfigNode& root) {
 
   PlatformParams p;
   p.base_joints_in_B_m = JointsOnCircle(platform.PositiveDouble("base_joint_radius_m"),
-                                   platform.Array6("base_joint_angles_deg"));
+                                        platform.Array6("base_joint_angles_deg"));
   p.platform_joints_in_P_m = JointsOnCircle(platform.PositiveDouble("platform_joint_radius_m"),
-                                       platform.Array6("platform_joint_angles_deg"));
+                                            platform.Array6("platform_joint_angles_deg"));
   p.platform_mass_kg = platform.PositiveDouble("mass_kg");
   p.platform_com_in_P_m = platform.Vec3("com_m");
   p.platform_inertia_kgm2 = platform.Vec3("inertia_kgm2");

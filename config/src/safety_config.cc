@@ -1,6 +1,6 @@
-#include "stewart/config/sections.h"
-
 #include <stdexcept>
+
+#include "stewart/config/sections.h"
 
 namespace stewart {
 namespace {
@@ -27,8 +27,7 @@ void ParseBounds(const ConfigNode& node, Limit* limit) {
 
 SafetyConfig ParseSafetyConfig(const ConfigNode& safety) {
   SafetyConfig s;
-  s.variant =
-      safety.EnumValue("variant", kSafetyVariantNames);
+  s.variant = safety.EnumValue("variant", kSafetyVariantNames);
   s.k_position = safety.PositiveDouble("k_position");
   s.k_velocity = safety.PositiveDouble("k_velocity");
   for (const ConfigNode& node : safety.List("position_limits")) {
@@ -65,8 +64,7 @@ SafetyConfig ParseSafetyConfig(const ConfigNode& safety) {
     s.stop_time_s = *stop;
   }
   if (safety.Has("correction_metric")) {
-    s.correction_metric =
-        safety.EnumValue("correction_metric", kCorrectionMetricNames);
+    s.correction_metric = safety.EnumValue("correction_metric", kCorrectionMetricNames);
   }
   if (safety.Has("velocity_robust_margin_mps2")) {
     s.velocity_robust_margin_mps2 = safety.NonNegativeDouble("velocity_robust_margin_mps2");

@@ -1,6 +1,6 @@
-#include "stewart/config/sections.h"
-
 #include <cmath>
+
+#include "stewart/config/sections.h"
 
 namespace stewart {
 

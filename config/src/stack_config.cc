@@ -1,11 +1,10 @@
-#include "stewart/config/config_loader.h"
-#include "stewart/config/sections.h"
-
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
 
+#include "stewart/config/config_loader.h"
+#include "stewart/config/sections.h"
 #include "stewart/model/kinematics.h"
 
 namespace stewart {

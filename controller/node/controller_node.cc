@@ -3,9 +3,9 @@
 #include <spdlog/spdlog.h>
 
 #include "stewart/node/eigen_msg.h"
-#include "stewart/node/signal_messages.h"
 #include "stewart/node/lcm_handle.h"
 #include "stewart/node/node_loop.h"
+#include "stewart/node/signal_messages.h"
 #include "stewart/node/stop_signal.h"
 
 namespace stewart {
@@ -29,8 +29,7 @@ ControllerNode::ControllerNode(const StackConfig& config, lcm::LCM* lcm,
       lcm_(lcm),
       receiver_(config.lcm.url),
       health_("controller", config.lcm.channels.health, config.lcm.health_rate_hz),
-      process_(config.platform, config.controller, config.home_pose, std::move(scenario),
-               &health_),
+      process_(config.platform, config.controller, config.home_pose, std::move(scenario), &health_),
       exit_at_end_(exit_at_end) {
   receiver_.Subscribe(config_.lcm.channels.state_estimate, &ControllerNode::OnState, this);
   // A scenario's setpoints are echoed on the setpoint channel: listening to
@@ -65,8 +64,9 @@ void ControllerNode::OnState(const lcm::ReceiveBuffer*, const std::string&, cons
 ExitCode ControllerNode::Run() {
   const auto& ch = config_.lcm.channels;
   spdlog::info("controller: {} -> {}{} on {}", ch.state_estimate, ch.command_nominal,
-               process_.controller().following_scenario() ? " + " + ch.setpoint
-                                                : " (live setpoints on " + ch.setpoint + ")",
+               process_.controller().following_scenario()
+                   ? " + " + ch.setpoint
+                   : " (live setpoints on " + ch.setpoint + ")",
                config_.lcm.url);
   return RunNodeLoop("controller", lcm_, &receiver_, &health_, kPollMs, [this] {
     if (!exit_at_end_ || !process_.controller().scenario_finished()) return false;

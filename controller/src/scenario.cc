@@ -21,7 +21,6 @@ Quintic MinimumJerk(double tau) {
           60.0 * tau - 180.0 * t2 + 120.0 * t3};
 }
 
-
 }  // namespace
 
 Setpoint EvaluateSegment(const ScenarioSegment& seg, double t_s) {

@@ -20,10 +20,9 @@ StateSample StateFromEstimate(const Estimate& estimate, int64_t seq) {
   return s;
 }
 
-EstimatorProcess::EstimatorProcess(const PlatformParams& platform,
-                                   const ActuatorConfig& actuators, const SensorConfig& sensors,
-                                   const EstimatorConfig& estimator, const Vector6d& home_pose,
-                                   HealthCounters* counters)
+EstimatorProcess::EstimatorProcess(const PlatformParams& platform, const ActuatorConfig& actuators,
+                                   const SensorConfig& sensors, const EstimatorConfig& estimator,
+                                   const Vector6d& home_pose, HealthCounters* counters)
     : ekf_(platform, actuators, sensors, estimator, home_pose), counters_(counters) {
   STEWART_CHECK(counters_ != nullptr, "EstimatorProcess needs its counters");
 }

@@ -69,7 +69,8 @@ void PredictAccel(const EkfVector& x, const Vector6d& qdd, const Vector3d& imu_o
 }
 
 Eigen::Matrix<double, 3, 6> AccelQddJacobian(const EkfVector& x, const Vector6d& qdd,
-                                             const Vector3d& imu_offset_in_P_m, double gravity_mps2) {
+                                             const Vector3d& imu_offset_in_P_m,
+                                             double gravity_mps2) {
   Eigen::Matrix<double, 3, 6> d;
   const Vector6d q = x.segment<6>(kEkfQ), qd = x.segment<6>(kEkfQd);
   // Affine in qdd: a unit difference is exact.

@@ -1,4 +1,3 @@
-#include "stewart/config/config_loader.h"
 #include "stewart/node/node_main.h"
 
 #include <spdlog/spdlog.h>
@@ -7,6 +6,7 @@
 #include <memory>
 
 #include "stewart/common/check.h"
+#include "stewart/config/config_loader.h"
 #include "stewart/node/lcm_handle.h"
 #include "stewart/node/node_options.h"
 #include "stewart/node/stop_signal.h"

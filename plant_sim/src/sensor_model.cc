@@ -42,8 +42,8 @@ SensorReading SensorModel::Sample(const Vector6d& q, const Vector6d& qd, const V
   r.gyro_radps = BodyAngularVelocity(q, qd) + sensors_.gyro_bias_radps;
   for (int i = 0; i < 3; ++i) r.gyro_radps(i) += sensors_.gyro_noise_std_radps * Gaussian();
 
-  r.accel_mps2 =
-      ImuSpecificForce(q, qd, qdd, sensors_.imu_offset_in_P_m, gravity_mps2_) + sensors_.accel_bias_mps2;
+  r.accel_mps2 = ImuSpecificForce(q, qd, qdd, sensors_.imu_offset_in_P_m, gravity_mps2_) +
+                 sensors_.accel_bias_mps2;
   for (int i = 0; i < 3; ++i) r.accel_mps2(i) += sensors_.accel_noise_std_mps2 * Gaussian();
 
   r.has_orientation = sensors_.has_orientation;

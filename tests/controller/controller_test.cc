@@ -1,6 +1,5 @@
 // The controller state machine: workspace rejection, invalid states, time
 // from utime, scenario following.
-#include "stewart/config/scenario_loader.h"
 #include "stewart/controller/controller.h"
 
 #include <gtest/gtest.h>
@@ -8,6 +7,7 @@
 #include <limits>
 
 #include "stewart/config/config_loader.h"
+#include "stewart/config/scenario_loader.h"
 
 namespace stewart {
 namespace {

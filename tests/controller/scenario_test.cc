@@ -1,6 +1,5 @@
 // Scenario files: the shipped ones say what their comments say; bad files
 // give errors naming the key.
-#include "stewart/config/scenario_loader.h"
 #include "stewart/controller/scenario.h"
 
 #include <gtest/gtest.h>
@@ -8,6 +7,7 @@
 #include <cmath>
 
 #include "stewart/config/config_loader.h"
+#include "stewart/config/scenario_loader.h"
 
 namespace stewart {
 namespace {

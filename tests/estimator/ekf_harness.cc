@@ -1,4 +1,5 @@
 #include "ekf_harness.h"
+
 #include "stewart/config/config_loader.h"
 
 namespace stewart::test {

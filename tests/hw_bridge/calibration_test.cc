@@ -1,8 +1,8 @@
-#include "stewart/config/sections.h"
 #include "stewart/hw_bridge/calibration.h"
 
 #include <gtest/gtest.h>
 
+#include "stewart/config/sections.h"
 #include "stewart/hw_bridge/drive_map.h"
 #include "stewart/hw_bridge/wire_format.h"
 #include "test_config.h"

@@ -4,13 +4,13 @@
 
 #include <vector>
 
-#include "stewart/test_support/lcm_messages.h"
 #include "stewart/force_command_t.hpp"
 #include "stewart/health_t.hpp"
 #include "stewart/safety_diagnostics_t.hpp"
 #include "stewart/sensor_t.hpp"
 #include "stewart/setpoint_t.hpp"
 #include "stewart/state_t.hpp"
+#include "stewart/test_support/lcm_messages.h"
 
 namespace stewart {
 namespace {

@@ -70,8 +70,8 @@ TEST(SensorModel, NoiseAndBiasMatchConfig) {
   check(ErrorMoments(&accel, n, 3,
                      [&](const SensorReading& r, const Vector6d& q, const Vector6d& qd,
                          const Vector6d& qdd, auto&) {
-                       return Eigen::VectorXd(r.accel_mps2 -
-                                              ImuSpecificForce(q, qd, qdd, cfg.imu_offset_in_P_m, g));
+                       return Eigen::VectorXd(
+                           r.accel_mps2 - ImuSpecificForce(q, qd, qdd, cfg.imu_offset_in_P_m, g));
                      }),
         cfg.accel_bias_mps2, cfg.accel_noise_std_mps2);
   SensorModel orient(cfg, Config().actuators, g);

@@ -19,14 +19,14 @@
 #include <string>
 #include <vector>
 
-#include "stewart/test_support/lcm_messages.h"
-#include "stewart/config/scenario_loader.h"
 #include "stewart/config/config_loader.h"
+#include "stewart/config/scenario_loader.h"
 #include "stewart/controller/controller.h"
 #include "stewart/force_command_t.hpp"
 #include "stewart/safety/diagnostics_lcm.h"
 #include "stewart/safety/safety_filter.h"
 #include "stewart/state_t.hpp"
+#include "stewart/test_support/lcm_messages.h"
 
 namespace stewart {
 namespace {
@@ -54,7 +54,6 @@ nlohmann::json ReadJson(const std::string& path) {
   std::ifstream in(path);
   return nlohmann::json::parse(in);
 }
-
 
 constexpr int kSamples = 200;
 constexpr int kInitializing = 5;   // first samples: estimator initialising -> node fallback

@@ -18,7 +18,6 @@
 namespace stewart {
 namespace {
 
-
 std::vector<std::string> Lines(const std::string& path) {
   std::ifstream in(path);
   std::vector<std::string> lines;

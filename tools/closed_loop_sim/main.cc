@@ -12,11 +12,11 @@
 #include <memory>
 #include <optional>
 
+#include "stewart/config/config_loader.h"
 #include "stewart/config/scenario_loader.h"
+#include "stewart/controller/scenario.h"
 #include "stewart/safety/clp_reference_qp.h"
 #include "stewart/stack/closed_loop.h"
-#include "stewart/config/config_loader.h"
-#include "stewart/controller/scenario.h"
 
 int main(int argc, char** argv) {
   using namespace stewart;

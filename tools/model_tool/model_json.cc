@@ -66,8 +66,8 @@ nlohmann::json EvaluateModelQuery(const PlatformParams& params, const ModelQuery
     base.push_back({b.x(), b.y(), b.z()});
     top.push_back({a.x(), a.y(), a.z()});
   }
-  out["base_joints_m"] = base;      // b_i in {B}
-  out["platform_joints_m"] = top;   // a_i = t + R p_i in {B}
+  out["base_joints_m"] = base;     // b_i in {B}
+  out["platform_joints_m"] = top;  // a_i = t + R p_i in {B}
   out["J_l"] = ToJson(Matrix6d(terms.H.transpose()));
   out["M"] = ToJson(terms.M);
   out["C_qd"] = ToJson(terms.C_qd);

@@ -22,12 +22,12 @@
 #include <optional>
 #include <string>
 
-#include "stewart/config/scenario_loader.h"
-#include "stewart/stack/replay.h"
-#include "stewart/stack/replay_output.h"
 #include "stewart/config/config_loader.h"
+#include "stewart/config/scenario_loader.h"
 #include "stewart/controller/scenario.h"
 #include "stewart/safety/clp_reference_qp.h"
+#include "stewart/stack/replay.h"
+#include "stewart/stack/replay_output.h"
 #ifdef STEWART_HAVE_ALGLIB
 #include "stewart/safety/alglib_reference_qp.h"
 #endif
@@ -235,9 +235,9 @@ int main(int argc, char** argv) {
   app.add_option("--config", o.config_path, "stack config (default: <run>/config.yaml)");
   app.add_option("--scenario", o.scenario_path,
                  "scenario for --controller (default: <run>/scenario.yaml)");
-  app.add_option("--variant", o.variant,
-                 stewart::kSafetyVariantNames.Names() +
-                     " (default: the run's, run.yaml, else the config's)");
+  app.add_option(
+      "--variant", o.variant,
+      stewart::kSafetyVariantNames.Names() + " (default: the run's, run.yaml, else the config's)");
   app.add_option("--qp-solver", o.qp_solver, "reference QP solver for variant qp: clp | alglib");
   app.add_option("--k-velocity", o.k_velocity, "override safety.k_velocity");
   app.add_option("--k-position", o.k_position, "override safety.k_position");

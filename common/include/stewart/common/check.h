@@ -37,16 +37,16 @@ namespace internal {
 
 }  // namespace stewart
 
-#define STEWART_CHECK(condition, message)                                          \
-  do {                                                                             \
-    if (!(condition)) {                                                            \
-      ::stewart::internal::FailCheck(#condition, __FILE__, __LINE__, (message));   \
-    }                                                                              \
+#define STEWART_CHECK(condition, message)                                        \
+  do {                                                                           \
+    if (!(condition)) {                                                          \
+      ::stewart::internal::FailCheck(#condition, __FILE__, __LINE__, (message)); \
+    }                                                                            \
   } while (false)
 
-#define STEWART_CHECK_INPUT(condition, key, reason)         \
-  do {                                                      \
-    if (!(condition)) {                                     \
-      throw ::stewart::InputError((key), (reason));         \
-    }                                                       \
+#define STEWART_CHECK_INPUT(condition, key, reason) \
+  do {                                              \
+    if (!(condition)) {                             \
+      throw ::stewart::InputError((key), (reason)); \
+    }                                               \
   } while (false)

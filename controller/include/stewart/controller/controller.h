@@ -5,8 +5,8 @@
 #include <optional>
 
 #include "stewart/common/enum_table.h"
-#include "stewart/controller/controller_config.h"
 #include "stewart/controller/control_law.h"
+#include "stewart/controller/controller_config.h"
 #include "stewart/controller/scenario.h"
 #include "stewart/model/dynamics.h"
 

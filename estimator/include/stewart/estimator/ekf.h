@@ -3,11 +3,11 @@
 // platform state [q, qd] plus the gyro bias. docs/estimator.md describes the
 // model, the tuning and the measured accuracy. No LCM, no heap allocation
 // per update, and time only from the samples' utime.
+#include "stewart/estimator/ekf_types.h"
 #include "stewart/estimator/estimator_config.h"
 #include "stewart/model/actuator_params.h"
-#include "stewart/model/sensor_params.h"
-#include "stewart/estimator/ekf_types.h"
 #include "stewart/model/platform_params.h"
+#include "stewart/model/sensor_params.h"
 
 namespace stewart {
 

@@ -20,7 +20,8 @@ void PredictGyro(const EkfVector& x, Vector3d* gyro_radps, MeasurementJacobian<3
 
 /// d(specific force)/d(qdd) at (q, qd) (3x6; the specific force is affine in qdd).
 Eigen::Matrix<double, 3, 6> AccelQddJacobian(const EkfVector& x, const Vector6d& qdd,
-                                             const Vector3d& imu_offset_in_P_m, double gravity_mps2);
+                                             const Vector3d& imu_offset_in_P_m,
+                                             double gravity_mps2);
 
 /// Accelerometer: specific force at the IMU, {P} (m/s^2), given the
 /// predicted qdd. The Jacobian holds qdd fixed (docs/estimator.md); with the

@@ -5,11 +5,12 @@
 //
 //   sync 0xA5 0x5A | version u8 | type u8 | payload_length u16 | seq u32 |
 //   payload (payload_length bytes) | crc32 u32 over version..payload
-#include "stewart/common/enum_table.h"
 #include <algorithm>
 #include <array>
 #include <cstddef>
 #include <cstdint>
+
+#include "stewart/common/enum_table.h"
 
 namespace stewart::hw {
 

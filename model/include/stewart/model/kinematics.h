@@ -12,8 +12,8 @@ namespace stewart {
 /// Per-leg geometry at one pose (all in {B}).
 struct LegGeometry {
   Eigen::Matrix<double, 3, kNumLegs> platform_offset_in_B_m;  ///< R p_i
-  Eigen::Matrix<double, 3, kNumLegs> unit_in_B;             ///< n_i = l_i / L_i
-  Vector6d length_m;                                     ///< L_i
+  Eigen::Matrix<double, 3, kNumLegs> unit_in_B;               ///< n_i = l_i / L_i
+  Vector6d length_m;                                          ///< L_i
 };
 
 /// Inverse kinematics at q = [x y z phi theta psi].

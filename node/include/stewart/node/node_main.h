@@ -24,8 +24,8 @@
 // returns.
 #include <CLI/CLI.hpp>
 #include <functional>
-#include <optional>
 #include <lcm/lcm-cpp.hpp>
+#include <optional>
 #include <string>
 
 #include "stewart/config/stack_config.h"

@@ -10,9 +10,9 @@
 #include <array>
 #include <string>
 
-#include "stewart/safety/safety_config.h"
 #include "stewart/model/platform_params.h"
 #include "stewart/model/types.h"
+#include "stewart/safety/safety_config.h"
 
 namespace stewart::safety {
 

@@ -4,8 +4,8 @@
 #include <array>
 #include <cstdint>
 
-#include "stewart/safety/safety_config.h"
 #include "stewart/safety/barriers.h"
+#include "stewart/safety/safety_config.h"
 #include "stewart/safety/two_constraint_qp.h"
 
 namespace stewart::safety {

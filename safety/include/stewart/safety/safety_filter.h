@@ -13,12 +13,12 @@
 //   SafetyDiagnostics diag;
 //   Vector6d f_safe = filter.Step(q, qd, f_des, &diag);
 #include "stewart/model/actuator_params.h"
-#include "stewart/safety/safety_config.h"
 #include "stewart/model/dynamics.h"
 #include "stewart/safety/constraint_set.h"
 #include "stewart/safety/diagnostics.h"
 #include "stewart/safety/filter_workspace.h"
 #include "stewart/safety/reference_qp.h"
+#include "stewart/safety/safety_config.h"
 #include "stewart/safety/uncomposed_qp.h"
 
 namespace stewart::safety {

@@ -10,7 +10,6 @@
 #include <cstdint>
 
 #include "stewart/common/enum_table.h"
-
 #include "stewart/model/types.h"
 #include "stewart/safety/projection_qp.h"  // kZeroNormal
 

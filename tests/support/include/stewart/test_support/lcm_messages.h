@@ -15,8 +15,7 @@ namespace stewart::test {
 
 /// Encodes `msg` and appends it to `log` on `channel` at `timestamp` (us).
 template <typename Msg>
-void AppendToLog(lcm::LogFile* log, const std::string& channel, const Msg& msg,
-                 int64_t timestamp) {
+void AppendToLog(lcm::LogFile* log, const std::string& channel, const Msg& msg, int64_t timestamp) {
   std::vector<uint8_t> buffer(static_cast<size_t>(msg.getEncodedSize()));
   msg.encode(buffer.data(), 0, static_cast<int>(buffer.size()));
   lcm::LogEvent event{};
