@@ -119,7 +119,7 @@ void EvaluateDynamics(const PlatformParams& params, const Vector6d& q, const Vec
   const Vector3d w_c = omega.cross(c);
   const Vector3d f_c = m * (omegad_bias.cross(c) + omega.cross(w_c));  // m a_bias at the CoM
   const Vector3d g_c(0.0, 0.0, m * g);
-  const Matrix3d I_world = R * params.platform_inertia_kgm2.asDiagonal() * R.transpose();
+  const Matrix3d I_world = R * PlatformInertiaInP(params) * R.transpose();
 
   const LegVectors cp = p.rowwise() * legs.c;
   const LegVectors dn = n.rowwise() * legs.d;
@@ -164,9 +164,21 @@ DynamicsTerms EvaluateDynamics(const PlatformParams& params, const Vector6d& q,
 }
 
 Vector6d ForwardDynamics(const DynamicsTerms& terms, const Vector6d& force_n) {
+  return ForwardDynamics(terms, force_n, Vector6d::Zero());
+}
+
+Vector6d ForwardDynamics(const DynamicsTerms& terms, const Vector6d& force_n,
+                         const Vector6d& external_generalised_force) {
   Cholesky6 inertia;
   if (!inertia.Compute(terms.M)) return Vector6d::Constant(NAN);
-  return inertia.Solve<1>(terms.H * force_n - terms.C_qd - terms.G);
+  return inertia.Solve<1>(terms.H * force_n + external_generalised_force - terms.C_qd - terms.G);
+}
+
+Vector6d GeneralisedForceOfWrench(const Vector6d& q, const Vector6d& wrench_in_B) {
+  Vector6d out;
+  out.head<3>() = wrench_in_B.head<3>();
+  out.tail<3>().noalias() = EulerRateMatrix(Vector3d(q.tail<3>())).transpose() * wrench_in_B.tail<3>();
+  return out;
 }
 
 Vector6d InverseDynamics(const DynamicsTerms& terms, const Vector6d& qdd) {

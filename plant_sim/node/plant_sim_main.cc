@@ -5,6 +5,7 @@
 
 #include "plant_sim_node.h"
 #include "stewart/common/check.h"
+#include "stewart/config/truth_loader.h"
 #include "stewart/node/node_main.h"
 
 namespace {
@@ -27,6 +28,8 @@ int main(int argc, char** argv) {
   int64_t seed = -1;
   std::string integrator;
   double rate_hz = 0.0;
+  std::string truth_path;
+  stewart::PlantTruth truth;
   return stewart::NodeMain(
       argc, argv, {"plant_sim", "plant_sim: the Stewart platform simulated with SUNDIALS, on LCM"},
       [&](CLI::App& app) {
@@ -51,6 +54,10 @@ int main(int argc, char** argv) {
         app.add_option("--rate-hz", rate_hz,
                        "sensor and control tick rate (default: sensors.rate_hz)")
             ->check(CLI::PositiveNumber);
+        app.add_option("--truth", truth_path,
+                       "YAML overriding the plant's physics (docs/simulation.md, \"Truth\"); "
+                       "default: the config's values")
+            ->check(CLI::ExistingFile);
         app.add_option("--start-utime", options.start_utime,
                        "utime of tick 0 in us (default: 0 in lockstep, wall clock in real time)");
         app.add_option(
@@ -67,12 +74,16 @@ int main(int argc, char** argv) {
         if (rate_hz > 0.0) config.sensors.rate_hz = rate_hz;
         options.mode =
             mode == "lockstep" ? stewart::SimMode::kLockstep : stewart::SimMode::kRealTime;
+        truth = stewart::LoadPlantTruth(config, truth_path);
+        ToVector6(initial_pose, "--initial-pose", &truth.initial_pose);
+        ToVector6(initial_velocity, "--initial-velocity", &truth.initial_velocity);
         return std::nullopt;
       },
       [&](const stewart::StackConfig& config, lcm::LCM* lcm) {
-        stewart::PlantSimNode node(config, lcm, options);
-        spdlog::info("plant_sim: {} mode, {} Hz, integrator {}, lcm {}", mode,
-                     config.sensors.rate_hz, config.plant_sim.integrator, config.lcm.url);
+        stewart::PlantSimNode node(config, truth, lcm, options);
+        spdlog::info("plant_sim: {} mode, {} Hz, integrator {}, lcm {}, truth {}", mode,
+                     config.sensors.rate_hz, config.plant_sim.integrator, config.lcm.url,
+                     truth_path.empty() ? "= config" : truth_path);
         return node.Run();
       });
 }

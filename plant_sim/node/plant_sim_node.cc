@@ -27,13 +27,15 @@ int64_t PeriodUs(double rate_hz) {
 
 }  // namespace
 
-PlantSimNode::PlantSimNode(const StackConfig& config, lcm::LCM* lcm, const PlantSimOptions& options)
+PlantSimNode::PlantSimNode(const StackConfig& config, const PlantTruth& truth, lcm::LCM* lcm,
+                           const PlantSimOptions& options)
     : config_(config),
       options_(options),
       lcm_(lcm),
       receiver_(config.lcm.url),
-      plant_(PlantModel{config.platform, config.actuators}, OdeOptionsFrom(config.plant_sim)),
-      sensors_(config.sensors, config.actuators, config.platform.gravity_mps2),
+      plant_(PlantModelOf(truth), OdeOptionsFrom(config.plant_sim)),
+      sensors_(truth.sensors, truth.actuators, truth.platform.gravity_mps2, truth.sensor_errors),
+      disturbance_(truth.disturbance, truth.sensors.seed),
       health_("plant_sim", config.lcm.channels.health, config.lcm.health_rate_hz),
       hold_(config.plant_sim.command_timeout_s,
             ParseTimeoutFallback(config.plant_sim.timeout_fallback)),
@@ -41,7 +43,7 @@ PlantSimNode::PlantSimNode(const StackConfig& config, lcm::LCM* lcm, const Plant
       gate_(options.mode == SimMode::kLockstep),
       latency_tracker_(0, period_us_),
       tick_accounting_(0, period_us_) {
-  plant_.Reset(0.0, config.plant_sim.initial_pose, config.plant_sim.initial_velocity);
+  plant_.Reset(0.0, truth.initial_pose, truth.initial_velocity);
   receiver_.Subscribe(config.lcm.channels.command_safe, &PlantSimNode::HandleCommand, this);
 }
 
@@ -118,6 +120,7 @@ void PlantSimNode::PublishSample() {
 }
 
 void PlantSimNode::AdvanceTick() {
+  plant_.SetExternalWrench(disturbance_.WrenchAt(plant_.time_s()));
   plant_.Advance(static_cast<double>(period_us_) * 1e-6);
   const PlantCounters c = plant_.counters();
   health_.SetCounter("endstop_hits", c.endstop_hits);

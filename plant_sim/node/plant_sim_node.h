@@ -14,10 +14,12 @@
 #include "stewart/node/lcm_receiver.h"
 #include "stewart/plant_sim/command_gate.h"
 #include "stewart/plant_sim/command_policy.h"
+#include "stewart/plant_sim/disturbance_source.h"
 #include "stewart/plant_sim/loop_latency_tracker.h"
 #include "stewart/plant_sim/plant.h"
 #include "stewart/plant_sim/sensor_model.h"
 #include "stewart/plant_sim/tick_accounting.h"
+#include "stewart/plant_sim/truth.h"
 #include "stewart/sensor_t.hpp"
 
 namespace stewart {
@@ -36,7 +38,10 @@ struct PlantSimOptions {
 
 class PlantSimNode {
  public:
-  PlantSimNode(const StackConfig& config, lcm::LCM* lcm, const PlantSimOptions& options);
+  /// `truth`: the plant's physics; the stack's config for everything else
+  /// (rate, channels, integrator, timeouts).
+  PlantSimNode(const StackConfig& config, const PlantTruth& truth, lcm::LCM* lcm,
+               const PlantSimOptions& options);
   /// Runs to the end of the duration or a stop signal: kOk, kLockstepTimeout
   /// or kIntegrationFailure.
   ExitCode Run();
@@ -58,6 +63,7 @@ class PlantSimNode {
   LcmReceiver receiver_;
   Plant plant_;
   SensorModel sensors_;
+  DisturbanceSource disturbance_;
   HealthReporter health_;
   RealTimeCommandHold hold_;
   int64_t period_us_ = 1000;

@@ -13,6 +13,11 @@ Vector6d FrictionForce(const ActuatorConfig& actuators, const Vector6d& leg_spee
   return LegViscousFriction(actuators.viscous_friction_nspm, leg_speed_mps);
 }
 
+Vector6d CoulombFrictionForce(const Vector6d& coulomb_friction_n, const Vector6d& leg_speed_mps) {
+  return -coulomb_friction_n.cwiseProduct(
+      (leg_speed_mps / kCoulombSpeedScaleMps).array().tanh().matrix());
+}
+
 Vector6d EndStopForce(const ActuatorConfig& actuators, const Vector6d& leg_length_m,
                       const Vector6d& leg_speed_mps) {
   const double l_min = actuators.min_length_m;

@@ -39,15 +39,39 @@ void Plant::Reset(double t_s, const Vector6d& q, const Vector6d& qd) {
   x_.segment<6>(6) = qd;
   inputs_ = PlantInputs{};
   endstop_hits_ = 0;
+  delayed_head_ = delayed_count_ = 0;
   MarkDiscontinuity();
 }
 
 void Plant::SetForceCommand(const Vector6d& force_cmd_n) {
+  if (!(model_.command_delay_s > 0.0)) {
+    ApplyForceCommand(force_cmd_n);
+    return;
+  }
+  if (delayed_count_ == kDelayCapacity) {
+    ApplyForceCommand(delayed_[static_cast<size_t>(delayed_head_)].force_cmd_n);
+    delayed_head_ = (delayed_head_ + 1) % kDelayCapacity;
+    --delayed_count_;
+    ++delayed_dropped_;
+  }
+  const int tail = (delayed_head_ + delayed_count_) % kDelayCapacity;
+  delayed_[static_cast<size_t>(tail)] = DelayedCommand{t_s_ + model_.command_delay_s, force_cmd_n};
+  ++delayed_count_;
+}
+
+void Plant::SetExternalWrench(const Vector6d& wrench) {
+  if (wrench == inputs_.external_wrench) return;
+  inputs_.external_wrench = wrench;
+  MarkDiscontinuity();
+}
+
+void Plant::ApplyForceCommand(const Vector6d& force_cmd_n) {
   if (force_cmd_n == inputs_.force_cmd_n) return;
   inputs_.force_cmd_n = force_cmd_n;
   if (!(model_.actuators.force_lag_s > 0.0)) {
     // Without lag the motor force is the saturated command; the state keeps it for output.
-    x_.segment<6>(12) = SaturateForce(model_.actuators, force_cmd_n);
+    x_.segment<6>(12) =
+        model_.actuator_errors.force_gain.cwiseProduct(SaturateForce(model_.actuators, force_cmd_n));
   }
   MarkDiscontinuity();
 }
@@ -57,7 +81,8 @@ void Plant::SetActuatorsOff(bool off) {
   inputs_.legs_locked = off;
   if (off) {
     inputs_.lock_length_m = InverseKinematics(model_.platform, q());
-    SetForceCommand(Vector6d::Zero());
+    delayed_head_ = delayed_count_ = 0;
+    ApplyForceCommand(Vector6d::Zero());
   }
   MarkDiscontinuity();
 }
@@ -65,6 +90,17 @@ void Plant::SetActuatorsOff(bool off) {
 void Plant::Advance(double dt_s) {
   if (!(dt_s > 0.0)) throw std::invalid_argument("Plant::Advance: dt_s must be positive");
   const double t_end = t_s_ + dt_s;
+  while (delayed_count_ > 0 && delayed_[static_cast<size_t>(delayed_head_)].apply_s < t_end) {
+    const DelayedCommand& next = delayed_[static_cast<size_t>(delayed_head_)];
+    if (next.apply_s > t_s_) IntegrateTo(next.apply_s);
+    ApplyForceCommand(next.force_cmd_n);
+    delayed_head_ = (delayed_head_ + 1) % kDelayCapacity;
+    --delayed_count_;
+  }
+  IntegrateTo(t_end);
+}
+
+void Plant::IntegrateTo(double t_end) {
   std::array<int, kNumRoots> roots_found{};
   for (int stops = 0;; ++stops) {
     if (stops > kMaxRootStopsPerAdvance) {
@@ -115,6 +151,7 @@ bool Plant::InEndStop() const {
 PlantCounters Plant::counters() const {
   PlantCounters c;
   c.endstop_hits = endstop_hits_;
+  c.delayed_commands_dropped = delayed_dropped_;
   c.ode = integrator_.stats();
   return c;
 }

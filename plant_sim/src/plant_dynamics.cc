@@ -18,7 +18,8 @@ void PlantDerivativeGivenTerms(const PlantModel& model, const PlantInputs& input
   const Vector6d leg_speed_mps = terms.H.transpose() * qd;  // Ld = J_l qd, H = J_l^T
 
   const ActuatorConfig& act = model.actuators;
-  const Vector6d force_sat_n = SaturateForce(act, inputs.force_cmd_n);
+  const Vector6d force_sat_n =
+      model.actuator_errors.force_gain.cwiseProduct(SaturateForce(act, inputs.force_cmd_n));
   Vector6d force_motor_n;
   Vector6d force_motor_rate = Vector6d::Zero();
   if (act.force_lag_s > 0.0) {
@@ -30,12 +31,20 @@ void PlantDerivativeGivenTerms(const PlantModel& model, const PlantInputs& input
 
   Vector6d leg_force_n = force_motor_n + FrictionForce(act, leg_speed_mps) +
                          EndStopForce(act, leg_length_m, leg_speed_mps);
+  if (!model.actuator_errors.coulomb_friction_n.isZero()) {
+    leg_force_n += CoulombFrictionForce(model.actuator_errors.coulomb_friction_n, leg_speed_mps);
+  }
   if (inputs.legs_locked) {
     leg_force_n += LegLockForce(act, leg_length_m, leg_speed_mps, inputs.lock_length_m);
   }
   rates->leg_force_n = leg_force_n;
   rates->x_dot.segment<6>(0) = qd;
-  rates->x_dot.segment<6>(6) = ForwardDynamics(terms, leg_force_n);
+  if (inputs.external_wrench.isZero()) {
+    rates->x_dot.segment<6>(6) = ForwardDynamics(terms, leg_force_n);
+  } else {
+    rates->x_dot.segment<6>(6) = ForwardDynamics(
+        terms, leg_force_n, GeneralisedForceOfWrench(PoseOf(x), inputs.external_wrench));
+  }
   rates->x_dot.segment<6>(12) = force_motor_rate;
 }
 

@@ -9,6 +9,7 @@
 #include "stewart/common/signals.h"
 #include "stewart/controller/controller_process.h"
 #include "stewart/estimator/estimator_process.h"
+#include "stewart/plant_sim/disturbance_source.h"
 #include "stewart/plant_sim/ode_integrator.h"
 #include "stewart/plant_sim/plant.h"
 #include "stewart/plant_sim/sensor_model.h"
@@ -17,22 +18,32 @@
 namespace stewart {
 namespace {
 
-void TrackLimitExcess(const SafetyConfig& s, const Vector6d& q, const Vector6d& qd,
-                      ClosedLoopSummary* out) {
-  auto consider = [&](double excess, int axis, const char* what) {
-    if (excess > out->max_limit_excess) {
-      out->max_limit_excess = excess;
-      out->max_limit_excess_name = std::string(kAxisNames[axis]) + what;
-    }
-  };
+// Calls visit(name, margin) for every configured limit, in LimitNames order.
+template <typename Visit>
+void ForEachLimit(const SafetyConfig& s, const Vector6d& q, const Vector6d& qd, Visit&& visit) {
+  auto name = [](int axis, const char* what) { return std::string(kAxisNames[axis]) + what; };
   for (const PositionLimitConfig& l : s.position_limits) {
-    if (l.upper) consider(q(l.axis) - *l.upper, l.axis, " upper");
-    if (l.lower) consider(*l.lower - q(l.axis), l.axis, " lower");
+    if (l.upper) visit(name(l.axis, "_upper"), *l.upper - q(l.axis));
+    if (l.lower) visit(name(l.axis, "_lower"), q(l.axis) - *l.lower);
   }
   for (const VelocityLimitConfig& l : s.velocity_limits) {
-    if (l.upper) consider(qd(l.axis) - *l.upper, l.axis, "d upper");
-    if (l.lower) consider(*l.lower - qd(l.axis), l.axis, "d lower");
+    if (l.upper) visit(name(l.axis, "d_upper"), *l.upper - qd(l.axis));
+    if (l.lower) visit(name(l.axis, "d_lower"), qd(l.axis) - *l.lower);
   }
+}
+
+void TrackLimitExcess(const SafetyConfig& s, const Vector6d& q, const Vector6d& qd,
+                      ClosedLoopSummary* out) {
+  std::size_t i = 0;
+  ForEachLimit(s, q, qd, [&](const std::string& name, double margin) {
+    LimitMargin& m = out->limit_margins[i++];
+    m.worst_margin = std::min(m.worst_margin, margin);
+    if (-margin > out->max_limit_excess) {
+      out->max_limit_excess = -margin;
+      out->max_limit_excess_name = name;
+      std::replace(out->max_limit_excess_name.begin(), out->max_limit_excess_name.end(), '_', ' ');
+    }
+  });
 }
 
 // Whether the setpoint of `axis` lies within that axis' configured limits.
@@ -47,13 +58,25 @@ bool SetpointInside(const SafetyConfig& s, int axis, double q_des) {
 
 }  // namespace
 
+std::vector<std::string> LimitNames(const SafetyConfig& safety) {
+  std::vector<std::string> names;
+  ForEachLimit(safety, Vector6d::Zero(), Vector6d::Zero(),
+               [&](const std::string& name, double) { names.push_back(name); });
+  return names;
+}
+
 ClosedLoopSummary RunClosedLoop(const StackConfig& config, const Scenario& scenario,
                                 const ClosedLoopOptions& options, std::ostream* csv) {
   SensorConfig sensors = config.sensors;
   sensors.seed = static_cast<unsigned>(options.seed);
-  Plant plant(PlantModel{config.platform, config.actuators}, OdeOptionsFrom(config.plant_sim));
-  plant.Reset(0.0, config.plant_sim.initial_pose, config.plant_sim.initial_velocity);
-  SensorModel sensor_model(sensors, config.actuators, config.platform.gravity_mps2);
+  PlantTruth truth = options.truth ? *options.truth : TruthOfConfig(config);
+  truth.sensors.seed = sensors.seed;
+  truth.sensors.rate_hz = sensors.rate_hz;
+  Plant plant(PlantModelOf(truth), OdeOptionsFrom(config.plant_sim));
+  plant.Reset(0.0, truth.initial_pose, truth.initial_velocity);
+  SensorModel sensor_model(truth.sensors, truth.actuators, truth.platform.gravity_mps2,
+                           truth.sensor_errors);
+  DisturbanceSource disturbance(truth.disturbance, truth.sensors.seed);
   // The processes' own classes, stepped in the order lockstep runs them:
   // sample -> estimator -> controller -> safety -> plant.
   HealthCounters estimator_counters("estimator"), controller_counters("controller"),
@@ -69,6 +92,19 @@ ClosedLoopSummary RunClosedLoop(const StackConfig& config, const Scenario& scena
   const long ticks = std::lround(options.duration_s * 1e6 / static_cast<double>(period_us));
   ClosedLoopSummary out;
   out.period_s = static_cast<double>(period_us) * 1e-6;
+  for (std::string& name : LimitNames(config.safety)) out.limit_margins.push_back({name});
+  // Plant::Advance throws when SUNDIALS fails: the run ends there, reported.
+  auto advance = [&](const Vector6d& force_n) {
+    plant.SetForceCommand(force_n);
+    plant.SetExternalWrench(disturbance.WrenchAt(plant.time_s()));
+    try {
+      plant.Advance(static_cast<double>(period_us) * 1e-6);
+    } catch (const std::runtime_error& e) {
+      out.failure = e.what();
+      return false;
+    }
+    return true;
+  };
   double sq_q = 0.0, sq_qd = 0.0;
   Vector6d sq_tracking = Vector6d::Zero();
   long estimated_ticks = 0;
@@ -90,13 +126,13 @@ ClosedLoopSummary RunClosedLoop(const StackConfig& config, const Scenario& scena
     StateSample state;
     bool has_state = false;
     if (options.perfect_state) {
-      StateSample truth;
-      truth.utime = truth.sample_utime = utime;
-      truth.seq = k;
-      truth.q = q_true;
-      truth.qd = qd_true;
-      truth.status = kStateValid | kStateGroundTruth;
-      has_state = estimator.OnTruth(truth, &state);
+      StateSample true_state;
+      true_state.utime = true_state.sample_utime = utime;
+      true_state.seq = k;
+      true_state.q = q_true;
+      true_state.qd = qd_true;
+      true_state.status = kStateValid | kStateGroundTruth;
+      has_state = estimator.OnTruth(true_state, &state);
     } else {
       SensorSample sample;
       sample.utime = utime;
@@ -113,7 +149,7 @@ ClosedLoopSummary RunClosedLoop(const StackConfig& config, const Scenario& scena
       }
     }
     if (!has_state) {
-      plant.Advance(static_cast<double>(period_us) * 1e-6);
+      if (!advance(f_safe)) break;
       continue;
     }
     ControllerProcessOutput nominal;
@@ -149,6 +185,7 @@ ClosedLoopSummary RunClosedLoop(const StackConfig& config, const Scenario& scena
       ++out.case_ticks[static_cast<size_t>(d->filter_case)];
       if (d->infeasible) ++out.infeasible_ticks;
     }
+    if (has_safe && safe.fallback_reason != 0) ++out.fallback_ticks;
     const double f_max = f_safe.cwiseAbs().maxCoeff();
     out.max_force_n = std::max(out.max_force_n, f_max);
     if (f_max > config.actuators.force_limit_n) ++out.saturated_ticks;
@@ -167,8 +204,7 @@ ClosedLoopSummary RunClosedLoop(const StackConfig& config, const Scenario& scena
       *csv << ',' << (d ? static_cast<int>(d->filter_case) : -1) << ','
            << (d ? d->barriers.h_pos : 0.0) << ',' << (d ? d->barriers.h_vel : 0.0) << '\n';
     }
-    plant.SetForceCommand(f_safe);
-    plant.Advance(static_cast<double>(period_us) * 1e-6);
+    if (!advance(f_safe)) break;
     const Vector6d q1 = plant.q(), qd1 = plant.qd();
     out.q_max = out.q_max.cwiseMax(q1);
     out.q_min = out.q_min.cwiseMin(q1);
@@ -176,8 +212,14 @@ ClosedLoopSummary RunClosedLoop(const StackConfig& config, const Scenario& scena
     out.qd_min = out.qd_min.cwiseMin(qd1);
     TrackLimitExcess(config.safety, q1, qd1, &out);
     ++out.ticks;
-    if (!q1.allFinite() || !qd1.allFinite()) return out;
+    if (!q1.allFinite() || !qd1.allFinite()) {
+      out.failure = "non-finite plant state";
+      break;
+    }
   }
+  out.endstop_hits = plant.counters().endstop_hits;
+  out.estimator_rejections = estimator_counters.rejected_inputs();
+  if (!out.failure.empty()) return out;
   out.q_final = plant.q();
   // The first initialisation is the start, not a restart.
   out.estimator_reinits =
@@ -190,6 +232,11 @@ ClosedLoopSummary RunClosedLoop(const StackConfig& config, const Scenario& scena
     const long n = out.inside_ticks[static_cast<size_t>(a)];
     if (n > 0)
       out.rms_tracking_error_inside(a) = std::sqrt(sq_tracking(a) / static_cast<double>(n));
+  }
+  const long n_translation = out.inside_ticks[0] + out.inside_ticks[1] + out.inside_ticks[2];
+  if (n_translation > 0) {
+    out.rms_translation_tracking_inside_m =
+        std::sqrt(sq_tracking.head<3>().sum() / static_cast<double>(n_translation));
   }
   out.completed = true;
   return out;

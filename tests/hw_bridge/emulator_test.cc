@@ -4,6 +4,7 @@
 #include <memory>
 #include <vector>
 
+#include "stewart/config/truth_loader.h"
 #include "stewart/hw_bridge/bridge.h"
 #include "stewart/hw_emulator/device_emulator.h"
 #include "stewart/hw_emulator/plant_backend.h"
@@ -108,11 +109,19 @@ TEST(DeviceWatchdog, CommandActsFromItsArrivalAndExpiresOnTime) {
   EXPECT_EQ(f.device_time_us, 6000U);
 }
 
+// The config's plant at rest at home.
+PlantTruth TruthAtRest(const StackConfig& c) {
+  PlantTruth truth = TruthOfConfig(c);
+  truth.initial_pose = c.home_pose;
+  truth.initial_velocity.setZero();
+  return truth;
+}
+
 std::unique_ptr<PlantBackend> MakeBackend(bool noise) {
   const StackConfig& c = test::Config();
   PlantBackendOptions o;
   o.noise = noise;
-  return std::make_unique<PlantBackend>(c, c.home_pose, Vector6d::Zero(), o);
+  return std::make_unique<PlantBackend>(c, TruthAtRest(c), o);
 }
 
 TEST(SampleSchedule, SamplesOnThePeriodGridAndDropsEveryNth) {
@@ -213,7 +222,7 @@ TEST(PlantBackend, BridgePlusEmulatorEqualsPlantSim) {
   constexpr int64_t kLinkDelayUs = 40;
 
   // Device + bridge.
-  PlantBackend backend(c, c.home_pose, Vector6d::Zero());
+  PlantBackend backend(c, TruthAtRest(c));
   DeviceEmulator device(&backend);
   HwBridge bridge(c.hw_bridge, c.platform.leg_min_length_m,
                   c.platform.leg_max_length_m - c.platform.leg_min_length_m,

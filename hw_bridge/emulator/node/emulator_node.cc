@@ -47,12 +47,12 @@ uint64_t EmulatorPeriodUs(double rate_hz) {
   return period_us;
 }
 
-EmulatorNode::EmulatorNode(const StackConfig& config, lcm::LCM* lcm, const EmulatorOptions& options)
+EmulatorNode::EmulatorNode(const StackConfig& config, const PlantTruth& truth, lcm::LCM* lcm,
+                           const EmulatorOptions& options)
     : config_(config),
       lcm_(lcm),
       options_(options),
-      backend_(config, config.plant_sim.initial_pose, config.plant_sim.initial_velocity,
-               BackendOptions(options.noise)),
+      backend_(config, truth, BackendOptions(options.noise)),
       device_(&backend_),
       schedule_(EmulatorPeriodUs(options.rate_hz), options.drop_every),
       reader_(options.transport != "pty") {

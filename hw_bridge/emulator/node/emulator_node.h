@@ -39,7 +39,9 @@ class EmulatorNode {
  public:
   /// `lcm` may be null: no ground truth. Throws InputError for a rate whose
   /// period rounds to zero.
-  EmulatorNode(const StackConfig& config, lcm::LCM* lcm, const EmulatorOptions& options);
+  /// `truth`: the emulated platform's physics (TruthOfConfig for the config's own).
+  EmulatorNode(const StackConfig& config, const PlantTruth& truth, lcm::LCM* lcm,
+               const EmulatorOptions& options);
 
   /// Runs until the duration or a stop signal, then removes the pty link; kOk.
   ExitCode Run();

@@ -2,12 +2,15 @@
 // model (EmulatorNode). It runs without LCM: only --lcm-url turns on the
 // ground truth.
 #include "emulator_node.h"
+#include "stewart/config/truth_loader.h"
 #include "stewart/node/node_main.h"
 
 int main(int argc, char** argv) {
   stewart::EmulatorOptions options;
   bool no_noise = false;
   CLI::Option* lcm_url = nullptr;
+  std::string truth_path;
+  stewart::PlantTruth truth;
   return stewart::NodeMain(
       argc, argv,
       {"hw_emulator",
@@ -33,6 +36,10 @@ int main(int argc, char** argv) {
         app.add_option("--drop-every", options.drop_every,
                        "drop every Nth sensor frame (link tests)");
         app.add_flag("--no-noise", no_noise, "noise- and bias-free sensors");
+        app.add_option("--truth", truth_path,
+                       "YAML overriding the emulated platform's physics (docs/simulation.md, "
+                       "\"Truth\"); default: the config's values")
+            ->check(CLI::ExistingFile);
         // The shared --lcm-url, with this process's meaning: without it, no LCM at all.
         lcm_url = app.get_option("--lcm-url");
         lcm_url->description(
@@ -43,10 +50,11 @@ int main(int argc, char** argv) {
         if (options.rate_hz <= 0.0) options.rate_hz = config.sensors.rate_hz;
         stewart::EmulatorPeriodUs(options.rate_hz);
         options.noise = !no_noise;
+        truth = stewart::LoadPlantTruth(config, truth_path);
         return std::nullopt;
       },
       [&](const stewart::StackConfig& config, lcm::LCM* lcm) {
-        stewart::EmulatorNode node(config, lcm, options);
+        stewart::EmulatorNode node(config, truth, lcm, options);
         return node.Run();
       });
 }

@@ -26,18 +26,21 @@ SensorConfig SensorsOf(const SensorConfig& sensors, bool noise) {
 
 }  // namespace
 
-PlantBackend::PlantBackend(const StackConfig& config, const Vector6d& q0, const Vector6d& qd0,
+PlantBackend::PlantBackend(const StackConfig& config, const PlantTruth& truth,
                            const PlantBackendOptions& options)
-    : plant_(PlantModel{config.platform, config.actuators}, OdeOptionsFrom(config.plant_sim)),
-      sensors_(SensorsOf(config.sensors, options.noise), config.actuators,
-               config.platform.gravity_mps2),
+    : plant_(PlantModelOf(truth), OdeOptionsFrom(config.plant_sim)),
+      sensors_(SensorsOf(truth.sensors, options.noise), truth.actuators,
+               truth.platform.gravity_mps2, truth.sensor_errors),
+      disturbance_(truth.disturbance, truth.sensors.seed),
+      // The device's pots read with the stack's calibration: a truth with other
+      // stroke ends shows up as a calibration error, as on the prototype.
       calibration_(config.hw_bridge, config.actuators.min_length_m, config.actuators.stroke_m),
       imu_(config.hw_bridge),
       drive_map_(config.hw_bridge, config.actuators.force_limit_n),
       adc_max_(config.hw_bridge.adc_max_count),
       min_length_m_(config.actuators.min_length_m),
       max_length_m_(config.actuators.min_length_m + config.actuators.stroke_m) {
-  plant_.Reset(0.0, q0, qd0);
+  plant_.Reset(0.0, truth.initial_pose, truth.initial_velocity);
   // Powered off until the first command: the lead screws hold the legs.
   plant_.SetActuatorsOff(true);
   if (options.power_on_settle_s > 0.0) plant_.Advance(options.power_on_settle_s);
@@ -49,6 +52,7 @@ void PlantBackend::Step(const DriveArray& drive, double dt_s) {
   const bool all_locked = std::all_of(locked.begin(), locked.end(), [](bool l) { return l; });
   plant_.SetActuatorsOff(all_locked);
   if (!all_locked) plant_.SetForceCommand(drive_map_.DriveToForce(drive));
+  plant_.SetExternalWrench(disturbance_.WrenchAt(plant_.time_s()));
   plant_.Advance(dt_s);
 }
 

@@ -11,6 +11,7 @@
 #include "stewart/model/sensor_params.h"
 #include "stewart/node/lcm_config.h"
 #include "stewart/plant_sim/plant_sim_config.h"
+#include "stewart/plant_sim/truth.h"
 #include "stewart/safety/safety_config.h"
 
 namespace stewart {
@@ -28,5 +29,17 @@ struct StackConfig {
   LcmConfig lcm;
   std::string source_path;  ///< file it was loaded from, "" for strings
 };
+
+/// The plant equal to the model: the config's own physics and initial state,
+/// no errors (what a plant runs without a truth file).
+inline PlantTruth TruthOfConfig(const StackConfig& config) {
+  PlantTruth t;
+  t.platform = config.platform;
+  t.actuators = config.actuators;
+  t.sensors = config.sensors;
+  t.initial_pose = config.plant_sim.initial_pose;
+  t.initial_velocity = config.plant_sim.initial_velocity;
+  return t;
+}
 
 }  // namespace stewart

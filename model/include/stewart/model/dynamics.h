@@ -34,6 +34,16 @@ DynamicsTerms EvaluateDynamics(const PlatformParams& params, const Vector6d& q, 
 /// factorisation M = L D L^T (linear_algebra6.h). NaN when M is not
 /// positive definite (non-finite terms).
 Vector6d ForwardDynamics(const DynamicsTerms& terms, const Vector6d& force_n);
+/// The same with an external generalised force Q added to H F (N, N m):
+/// qdd = M^-1 (H F + Q - C qd - G).
+Vector6d ForwardDynamics(const DynamicsTerms& terms, const Vector6d& force_n,
+                         const Vector6d& external_generalised_force);
+
+/// The generalised force (conjugate to q, N and N m) of a wrench on the
+/// platform: wrench_in_B = [force (N); torque (N m)], both in {B} axes, the
+/// force acting through the origin of {P}. Q = [f; E(rpy)^T tau], E the Euler
+/// rate matrix (omega_B = E rpy_dot, rotation.h), by virtual power.
+Vector6d GeneralisedForceOfWrench(const Vector6d& q, const Vector6d& wrench_in_B);
 
 /// The F that solves H F = M qdd + C qd + G, by Gaussian elimination with
 /// partial pivoting (linear_algebra6.h). H is invertible away from singular

@@ -27,8 +27,11 @@ struct PlatformParams {
 
   double platform_mass_kg = 0.0;
   Vector3d platform_com_in_P_m = Vector3d::Zero();  ///< in {P}
-  /// Principal inertia about the CoM, axes of {P} (kg m^2): Ixx, Iyy, Izz.
+  /// Inertia about the CoM, axes of {P} (kg m^2): diagonal Ixx, Iyy, Izz...
   Vector3d platform_inertia_kgm2 = Vector3d::Zero();
+  /// ... and products Ixy, Ixz, Iyz (zero for the bare plate; a payload off
+  /// the axes adds them).
+  Vector3d platform_inertia_products_kgm2 = Vector3d::Zero();
 
   LegParams leg;
 
@@ -38,6 +41,15 @@ struct PlatformParams {
 
   double gravity_mps2 = 9.81;  ///< acts along -z of {B}
 };
+
+/// The platform's inertia tensor about its CoM in {P} axes (kg m^2).
+inline Matrix3d PlatformInertiaInP(const PlatformParams& p) {
+  const Vector3d& d = p.platform_inertia_kgm2;
+  const Vector3d& o = p.platform_inertia_products_kgm2;
+  Matrix3d I;
+  I << d(0), o(0), o(1), o(0), d(1), o(2), o(1), o(2), d(2);
+  return I;
+}
 
 /// Joint centres on a circle of `radius_m`, in pairs: joint angles (deg)
 /// measured from the x axis of the frame. Used to build the default geometry.

@@ -4,6 +4,7 @@
 // extending; lengths joint to joint (m), speeds dL/dt (m/s), forces (N).
 #include "stewart/model/actuator_params.h"
 #include "stewart/model/types.h"
+#include "stewart/plant_sim/truth.h"
 
 namespace stewart {
 
@@ -12,6 +13,10 @@ Vector6d SaturateForce(const ActuatorConfig& actuators, const Vector6d& force_cm
 
 /// Lead-screw viscous friction: F_f = -b Ld.
 Vector6d FrictionForce(const ActuatorConfig& actuators, const Vector6d& leg_speed_mps);
+
+/// Dry friction of the lead screw and gearbox, smoothed so the right-hand
+/// side stays Lipschitz: F = -F_c tanh(Ld / kCoulombSpeedScaleMps) (truth.h).
+Vector6d CoulombFrictionForce(const Vector6d& coulomb_friction_n, const Vector6d& leg_speed_mps);
 
 /// Stiff, damped end-stop at each stroke end. With penetration d > 0 beyond
 /// l_min (or l_max): F = k d - c Ld pushing back into the stroke, clamped so

@@ -1,6 +1,8 @@
 #pragma once
 // The simulated platform: plant state, zero-order-hold inputs and the
 // SUNDIALS integration between control ticks (docs/simulation.md).
+#include <array>
+
 #include "stewart/plant_sim/ode_integrator.h"
 #include "stewart/plant_sim/plant_dynamics.h"
 
@@ -8,6 +10,7 @@ namespace stewart {
 
 struct PlantCounters {
   long endstop_hits = 0;  ///< times a leg entered an end-stop (stroke end crossed outwards)
+  long delayed_commands_dropped = 0;  ///< applied early: the delay queue was full
   OdeStats ode;
 };
 
@@ -19,16 +22,21 @@ class Plant {
   /// actuators on.
   void Reset(double t_s, const Vector6d& q, const Vector6d& qd);
 
-  /// Zero-order hold: the command acts from now until the next change.
-  /// A change restarts the integrator, since f(x) jumps.
+  /// Zero-order hold: the command acts from now + model().command_delay_s
+  /// until the next change takes effect. A change restarts the integrator,
+  /// since f(x) jumps.
   void SetForceCommand(const Vector6d& force_cmd_n);
   /// Actuators off: zero force, and the lead screws hold every leg at its
-  /// length at this instant (LegLockForce). Restarts the integrator on change.
+  /// length at this instant (LegLockForce); drops commands not yet in effect.
+  /// Restarts the integrator on change.
   void SetActuatorsOff(bool off);
+  /// External wrench from now on ([N; N m] in {B}, PlantInputs).
+  void SetExternalWrench(const Vector6d& wrench);
 
-  /// Integrates the held inputs over dt_s (s). Stops and restarts at every
-  /// stroke-end crossing (the end-stop force is not smooth there), counting
-  /// entries into an end-stop. Throws std::runtime_error if SUNDIALS fails.
+  /// Integrates the held inputs over dt_s (s), switching to each delayed
+  /// command at its time. Stops and restarts at every stroke-end crossing
+  /// (the end-stop force is not smooth there), counting entries into an
+  /// end-stop. Throws std::runtime_error if SUNDIALS fails.
   void Advance(double dt_s);
 
   double time_s() const { return t_s_; }
@@ -48,6 +56,15 @@ class Plant {
   PlantCounters counters() const;
 
  private:
+  struct DelayedCommand {
+    double apply_s;
+    Vector6d force_cmd_n;
+  };
+  // Room for 0.5 s of delay at 1 kHz: far beyond any latency worth simulating.
+  static constexpr int kDelayCapacity = 512;
+
+  void ApplyForceCommand(const Vector6d& force_cmd_n);
+  void IntegrateTo(double t_end);
   static int Rhs(double t, const double* y, double* y_dot, void* self);
   static int Roots(double t, const double* y, double* g, void* self);
   // A change of the held inputs or a stroke-end crossing: restart, and
@@ -75,6 +92,10 @@ class Plant {
   bool restart_pending_ = true;
   long endstop_hits_ = 0;
   long inputs_revision_ = 0;
+  std::array<DelayedCommand, kDelayCapacity> delayed_{};  // ring, in time order
+  int delayed_head_ = 0;
+  int delayed_count_ = 0;
+  long delayed_dropped_ = 0;
   PlantRates rates_;  // f at rates_x_ under rates_revision_; no allocation per call
   PlantStateVector rates_x_ = PlantStateVector::Zero();
   long rates_revision_ = -1;  // -1: rates_ holds nothing yet

@@ -4,15 +4,20 @@
 //
 //   x = [q (m, rad), qd (m/s, rad/s), F_motor (N)]            (18 states)
 //   qd'      = M^-1 (H F_leg - C qd - G),
-//   F_leg    = F_motor - b Ld + F_endstop(L, Ld) [+ F_lock(L, Ld)],  Ld = H^T qd
-//   F_motor' = (sat(F_cmd) - F_motor) / tau     if force_lag_s = tau > 0,
-//   F_motor  = sat(F_cmd) (held in the state, rate 0) otherwise; Plant then
+//   qd'      = M^-1 (H F_leg + Q_ext - C qd - G)   with an external wrench,
+//   F_leg    = F_motor - b Ld - F_c tanh(Ld / v_c) + F_endstop(L, Ld) [+ F_lock(L, Ld)],
+//              Ld = H^T qd,
+//   F_motor' = (k sat(F_cmd) - F_motor) / tau   if force_lag_s = tau > 0,
+//   F_motor  = k sat(F_cmd) (held in the state, rate 0) otherwise; Plant then
 //              integrates only q and qd (docs/simulation.md, "Integrator").
+// k (force gain) and F_c (Coulomb friction) come from the truth
+// (truth.h); the model's defaults are k = 1, F_c = 0.
 #include <Eigen/Core>
 
 #include "stewart/model/actuator_params.h"
 #include "stewart/model/dynamics.h"
 #include "stewart/model/platform_params.h"
+#include "stewart/plant_sim/truth.h"
 
 namespace stewart {
 
@@ -21,15 +26,34 @@ using PlantStateVector = Eigen::Matrix<double, kPlantStateSize, 1>;
 
 /// The physical plant: rigid-body model plus actuators.
 struct PlantModel {
+  PlantModel() = default;
+  PlantModel(const PlatformParams& platform_params, const ActuatorConfig& actuator_config,
+             const ActuatorTruth& errors = ActuatorTruth{}, double delay_s = 0.0)
+      : platform(platform_params),
+        actuators(actuator_config),
+        actuator_errors(errors),
+        command_delay_s(delay_s) {}
+
   PlatformParams platform;
   ActuatorConfig actuators;
+  ActuatorTruth actuator_errors;
+  double command_delay_s = 0.0;  ///< a command acts this long after it is set
 };
+
+/// The plant of a truth.
+inline PlantModel PlantModelOf(const PlantTruth& truth) {
+  return PlantModel{truth.platform, truth.actuators, truth.actuator_errors,
+                    truth.latency.total_s()};
+}
 
 /// Inputs held constant over one integration interval (zero-order hold).
 struct PlantInputs {
   Vector6d force_cmd_n = Vector6d::Zero();  ///< commanded leg forces, before saturation
   bool legs_locked = false;                 ///< unpowered: the lead screws hold their length
   Vector6d lock_length_m = Vector6d::Zero();
+  /// External wrench on the platform, [force (N); torque (N m)] in {B},
+  /// force through the origin of {P} (GeneralisedForceOfWrench).
+  Vector6d external_wrench = Vector6d::Zero();
 };
 
 inline Eigen::Ref<const Vector6d> PoseOf(const PlantStateVector& x) { return x.segment<6>(0); }

@@ -7,6 +7,7 @@
 #include "stewart/model/actuator_params.h"
 #include "stewart/model/sensor_params.h"
 #include "stewart/model/types.h"
+#include "stewart/plant_sim/truth.h"
 
 namespace stewart {
 
@@ -29,12 +30,15 @@ Vector6d QuantiseLegLength(const SensorConfig& sensors, const ActuatorConfig& ac
 
 class SensorModel {
  public:
-  SensorModel(const SensorConfig& sensors, const ActuatorConfig& actuators, double gravity_mps2);
+  /// `errors`: the truth's sensor errors (none by default).
+  SensorModel(const SensorConfig& sensors, const ActuatorConfig& actuators, double gravity_mps2,
+              const SensorTruth& errors = SensorTruth{});
 
-  /// One sample of the true motion (q, qd, qdd at one instant):
-  ///   legs   = ADC(L(q) + n_L),                n_L ~ N(0, leg_pot_noise_std_m^2)
-  ///   gyro   = BodyAngularVelocity + b_g + n_g
-  ///   accel  = ImuSpecificForce(at imu_offset_in_P_m) + b_a + n_a
+  /// One sample of the true motion (q, qd, qdd at one instant), with
+  /// u = (L - l_min) / stroke and R_m the IMU's misalignment (truth.h):
+  ///   legs   = ADC(s_L L(q) + o_L + a sin(pi u) + n_L),  n_L ~ N(0, leg_pot_noise_std_m^2)
+  ///   gyro   = s_g R_m^T BodyAngularVelocity + b_g + n_g
+  ///   accel  = s_a R_m^T ImuSpecificForce(at imu_offset_in_P_m) + b_a + n_a
   ///   orient = [phi theta psi] + n_o           (only if has_orientation)
   SensorReading Sample(const Vector6d& q, const Vector6d& qd, const Vector6d& qdd,
                        const Vector6d& leg_length_m);
@@ -46,6 +50,8 @@ class SensorModel {
 
   SensorConfig sensors_;
   ActuatorConfig actuators_;
+  SensorTruth errors_;
+  Matrix3d imu_from_P_;  // R_m^T
   double gravity_mps2_;
   std::mt19937_64 rng_;
   std::normal_distribution<double> standard_normal_{0.0, 1.0};

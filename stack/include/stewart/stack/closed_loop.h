@@ -4,7 +4,9 @@
 #include <array>
 #include <cstdint>
 #include <ostream>
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "stewart/config/stack_config.h"
 #include "stewart/controller/scenario.h"
@@ -21,7 +23,23 @@ struct ClosedLoopOptions {
   /// The reference solver for variant qp (must outlive the run); unused otherwise.
   safety::ReferenceQpSolver* reference = nullptr;
   std::uint64_t seed = 1;      ///< sensor noise seed (overrides sensors.seed)
+  /// The plant's physics; absent: the config's own (TruthOfConfig). The
+  /// estimator, controller and filter always use `config`.
+  std::optional<PlantTruth> truth;
 };
+
+/// One configured limit and how close ground truth came to it over a run:
+/// the smallest value of (upper - value) or (value - lower) (m or m/s,
+/// negative when the limit was exceeded).
+struct LimitMargin {
+  std::string name;  ///< "x_upper", "zd_upper", ... (axis, d for a rate, side)
+  double worst_margin = 1e9;
+  double excess() const { return worst_margin < 0.0 ? -worst_margin : 0.0; }
+};
+
+/// The names of the config's limits, in the order ClosedLoopSummary reports
+/// them: position limits, then velocity limits, upper before lower.
+std::vector<std::string> LimitNames(const SafetyConfig& safety);
 
 struct ClosedLoopSummary {
   bool completed = false;
@@ -30,10 +48,15 @@ struct ClosedLoopSummary {
   Vector6d qd_max = Vector6d::Constant(-1e9), qd_min = Vector6d::Constant(1e9);  ///< ground truth
   double max_limit_excess = -1e9;     ///< largest excess of any configured limit (m or m/s)
   std::string max_limit_excess_name;  ///< which limit, e.g. "xd upper"
+  std::vector<LimitMargin> limit_margins;  ///< every limit, LimitNames order
+  std::string failure;  ///< why the run stopped early (plant integration), "" if it did not
   double rms_q_error = 0.0;           ///< estimate vs truth, translations (m)
   double rms_qd_error = 0.0;          ///< estimate vs truth, translational rates (m/s)
   safety::FilterCaseCounts case_ticks{};  ///< ticks per FilterCase
   long infeasible_ticks = 0;
+  long fallback_ticks = 0;  ///< ticks the safety process answered with its fallback
+  long endstop_hits = 0;    ///< legs entering an end-stop (plant)
+  long estimator_rejections = 0;  ///< sensor samples or updates the estimator rejected
   long saturated_ticks = 0;  ///< ticks where |F*_i| exceeded the actuator force limit
   double max_force_n = 0.0;
   long estimator_reinits = 0;
@@ -48,6 +71,8 @@ struct ClosedLoopSummary {
   /// them (m, rad): the tracking the filter should not cost.
   std::array<long, kNumAxes> inside_ticks{};
   Vector6d rms_tracking_error_inside = Vector6d::Zero();
+  /// The same over x, y and z together: sqrt(sum of squares / ticks) (m).
+  double rms_translation_tracking_inside_m = 0.0;
   double mean_correction_n() const {
     return filtered_ticks > 0 ? sum_correction_n / static_cast<double>(filtered_ticks) : 0.0;
   }
@@ -55,7 +80,8 @@ struct ClosedLoopSummary {
 };
 
 /// Runs `scenario` for options.duration_s at the sensor rate. `csv`, when not
-/// null, receives one line per tick. Throws on invalid config.
+/// null, receives one line per tick. Throws on invalid config; a plant
+/// integration failure ends the run with `failure` set, not completed.
 ClosedLoopSummary RunClosedLoop(const StackConfig& config, const Scenario& scenario,
                                 const ClosedLoopOptions& options, std::ostream* csv);
 

@@ -20,8 +20,10 @@
 #include "stewart/hw_bridge/calibration.h"
 #include "stewart/hw_bridge/drive_map.h"
 #include "stewart/hw_emulator/device_backend.h"
+#include "stewart/plant_sim/disturbance_source.h"
 #include "stewart/plant_sim/plant.h"
 #include "stewart/plant_sim/sensor_model.h"
+#include "stewart/plant_sim/truth.h"
 
 namespace stewart::hw {
 
@@ -36,12 +38,13 @@ struct PlantBackendOptions {
 
 class PlantBackend final : public DeviceBackend {
  public:
-  /// Starts at (q0, qd0) with the actuators off (legs held) until the first
-  /// non-zero drive; the hold has settled for options.power_on_settle_s (the
-  /// platform sags by microns). Uses the `platform`, `actuators`, `sensors`, `plant_sim`
-  /// (integrator and tolerances) and `hw_bridge` (calibration, IMU scales,
-  /// drive map) sections of `config`.
-  PlantBackend(const StackConfig& config, const Vector6d& q0, const Vector6d& qd0,
+  /// Starts at the truth's initial state with the actuators off (legs held)
+  /// until the first non-zero drive; the hold has settled for
+  /// options.power_on_settle_s (the platform sags by microns). The physics
+  /// come from `truth`; `config` gives `plant_sim` (integrator and
+  /// tolerances) and `hw_bridge` (the calibration the device's pots and IMU
+  /// are read with, the drive map).
+  PlantBackend(const StackConfig& config, const PlantTruth& truth,
                const PlantBackendOptions& options = {});
   PlantBackend(const PlantBackend&) = delete;
   PlantBackend& operator=(const PlantBackend&) = delete;
@@ -60,6 +63,7 @@ class PlantBackend final : public DeviceBackend {
  private:
   Plant plant_;
   SensorModel sensors_;
+  DisturbanceSource disturbance_;
   LegCalibration calibration_;
   ImuScale imu_;
   DriveMap drive_map_;

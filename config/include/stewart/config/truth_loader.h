@@ -1,0 +1,31 @@
+#pragma once
+// The simulated plant's physics (docs/simulation.md, "Truth"): the stack
+// config's `platform`, `legs`, `actuators` and `sensors`, overridden key by key
+// by a truth file, plus what only a truth has (payload, per-joint errors,
+// actuator and sensor errors, latency, disturbance, initial state). Only the
+// plant (plant_sim, the device emulator, the in-process loops) reads a truth.
+#include <yaml-cpp/yaml.h>
+
+#include <string>
+
+#include "stewart/config/config_node.h"
+#include "stewart/config/stack_config.h"
+#include "stewart/plant_sim/truth.h"
+
+namespace stewart {
+
+/// The stack config (its file, config.source_path) overridden by the truth
+/// file; TruthOfConfig when truth_path is empty. The sensors' rate and seed
+/// stay the config's: they are how the simulation runs, not physics.
+/// Throws ConfigError naming the key ("truth.platform.payload.mass_kg").
+PlantTruth LoadPlantTruth(const StackConfig& config, const std::string& truth_path);
+
+/// The same from parsed YAML: `config_root` a whole stack config, `truth`
+/// a truth document (a mapping; an empty one gives the config's values).
+PlantTruth ParsePlantTruth(const StackConfig& config, const YAML::Node& config_root,
+                           const YAML::Node& truth);
+
+/// Reads a YAML file; ConfigError("<file>"/"<yaml>") when it cannot.
+YAML::Node LoadYamlFile(const std::string& path);
+
+}  // namespace stewart
