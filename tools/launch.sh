@@ -16,6 +16,9 @@ usage: tools/launch.sh [options]
   --realtime            wall-clock paced at the sensor rate (default for hw)
   --scenario NAME|FILE  config/scenarios/NAME.yaml (default: paper)
   --config FILE         stack config (default: config/platform.yaml)
+  --truth FILE          the plant's physics differ from the config (plant_sim or the
+                        device emulator only; docs/simulation.md, "Truth")
+  --seed N              sensor noise and disturbance seed of the simulated plant
   --variant V           safety filter: closed_form | paper | qp | uncomposed (default: from config)
   --duration S          simulated seconds (default: the scenario's duration)
   --log FILE            record every channel with lcm-logger (default: <run>/log.lcm)
@@ -35,6 +38,7 @@ USAGE
 
 PLANT=sim MODE="" SCENARIO=paper CONFIG="$ROOT/config/platform.yaml" VARIANT="" DURATION=""
 LOG="" DO_LOG=1 DO_REPORT=1 SPY=0 URL="" OUT="" EMULATOR=0 BUILD_FIRST=1 LCM_LOGGER=0 RT_PRIORITY='' LOOP_CPU=auto
+TRUTH="" SEED=
 ARGS="$*"
 while (($#)); do
   case "$1" in
@@ -45,6 +49,8 @@ while (($#)); do
     --scenario) SCENARIO=$2; shift ;;
     --config) CONFIG=$(realpath "$2"); shift ;;
     --variant) VARIANT=$2; shift ;;
+    --truth) TRUTH=$(realpath "$2") || exit 2; shift ;;
+    --seed) SEED=$2; shift ;;
     --duration) DURATION=$2; shift ;;
     --log) LOG=$(realpath -m "$2"); shift ;;
     --no-log) DO_LOG=0; DO_REPORT=0 ;;
@@ -63,6 +69,9 @@ while (($#)); do
 done
 [[ $PLANT == sim || $PLANT == hw ]] || { echo "launch: --plant sim|hw" >&2; exit 2; }
 [[ -n $MODE ]] || { [[ $PLANT == sim ]] && MODE=lockstep || MODE=realtime; }
+if [[ -n $TRUTH && $PLANT == hw && $EMULATOR == 0 ]]; then
+  echo "launch: --truth describes a simulated plant: use --plant sim or --device-emulator" >&2; exit 2
+fi
 if [[ $PLANT == hw && $MODE == lockstep ]]; then
   echo "launch: the real device cannot step in lockstep; use --realtime" >&2; exit 2
 fi
@@ -192,12 +201,16 @@ start estimator "${LOOP[@]}" "$ESTIMATOR" "${COMMON[@]}"
 "$MONITOR" "${COMMON[@]}" --wait-for safety,controller,estimator --timeout 15 ||
   { echo "launch: the stack did not come up" >&2; for n in safety controller estimator; do tail -n 5 "$OUT/$n.log" >&2; done; stop_all; exit 1; }
 
+# Only the plant reads the truth: the stack keeps the config's model.
+PLANT_ARGS=()
+[[ -z $TRUTH ]] || PLANT_ARGS+=(--truth "$TRUTH")
 if [[ $PLANT == sim ]]; then
-  start plant_sim "${LOOP[@]}" "$PLANT_SIM" "${COMMON[@]}" --mode "$MODE" --duration "$DURATION"
+  [[ -z $SEED ]] || PLANT_ARGS+=(--seed "$SEED")
+  start plant_sim "${LOOP[@]}" "$PLANT_SIM" "${COMMON[@]}" "${PLANT_ARGS[@]}" --mode "$MODE" --duration "$DURATION"
   PLANT_NAME=plant_sim
 else
   # The emulator publishes its ground truth (evaluation only) on the run's URL.
-  if ((EMULATOR)); then start hw_emulator "${RT[@]}" "$(bin hw_emulator)" "${COMMON[@]}"; fi
+  if ((EMULATOR)); then start hw_emulator "${RT[@]}" "$(bin hw_emulator)" "${COMMON[@]}" "${PLANT_ARGS[@]}"; fi
   start hw_bridge "${LOOP[@]}" "$(bin hw_bridge)" "${COMMON[@]}"
   PLANT_NAME=hw_bridge
 fi

@@ -16,6 +16,7 @@ PACKAGES=(
   python3-matplotlib python3-numpy python3-pil python3-yaml
   xvfb xauth x11-utils imagemagick
   iproute2 procps
+  parallel
 )
 
 missing=()

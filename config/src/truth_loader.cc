@@ -17,34 +17,50 @@ constexpr double kDegToRad = 3.141592653589793 / 180.0;
 constexpr double kMaxLatencyS = 0.4;  // Plant's delay queue holds 0.5 s at 1 kHz
 
 // Keys a truth may set, per section: the config's own and the truth's extras.
-const std::set<std::string> kPlatformKeys = {
-    "base_joint_radius_m",   "platform_joint_radius_m", "base_joint_angles_deg",
-    "platform_joint_angles_deg", "mass_kg",           "com_m",
-    "inertia_kgm2",          "gravity_mps2",            "home_pose",
-    "inertia_products_kgm2", "payload",                 "base_joint_radius_offsets_m",
-    "platform_joint_radius_offsets_m"};
-const std::set<std::string> kLegKeys = {"cylinder_mass_kg",      "cylinder_com_from_base_m",
-                                        "cylinder_inertia_kgm2", "rod_mass_kg",
+const std::set<std::string> kPlatformKeys = {"base_joint_radius_m",
+                                             "platform_joint_radius_m",
+                                             "base_joint_angles_deg",
+                                             "platform_joint_angles_deg",
+                                             "mass_kg",
+                                             "com_m",
+                                             "inertia_kgm2",
+                                             "gravity_mps2",
+                                             "home_pose",
+                                             "inertia_products_kgm2",
+                                             "payload",
+                                             "base_joint_radius_offsets_m",
+                                             "platform_joint_radius_offsets_m"};
+const std::set<std::string> kLegKeys = {"cylinder_mass_kg",        "cylinder_com_from_base_m",
+                                        "cylinder_inertia_kgm2",   "rod_mass_kg",
                                         "rod_com_from_platform_m", "rod_inertia_kgm2"};
 const std::set<std::string> kActuatorKeys = {
-    "min_length_m", "stroke_m",    "force_limit_n",         "viscous_friction_nspm",
-    "force_lag_s",  "endstop_stiffness_npm", "endstop_damping_nspm", "force_gain",
-    "coulomb_friction_n"};
-const std::set<std::string> kSensorKeys = {
-    "rate_hz",          "leg_pot_noise_std_m", "leg_adc_bits",     "gyro_noise_std_radps",
-    "gyro_bias_radps",  "accel_noise_std_mps2", "accel_bias_mps2", "imu_offset_m",
-    "has_orientation",  "orientation_noise_std_rad", "seed",       "leg_scale",
-    "leg_offset_m",     "leg_nonlinearity_m",  "gyro_scale",       "accel_scale",
-    "imu_misalignment_deg"};
+    "min_length_m",          "stroke_m",    "force_limit_n",
+    "viscous_friction_nspm", "force_lag_s", "endstop_stiffness_npm",
+    "endstop_damping_nspm",  "force_gain",  "coulomb_friction_n"};
+const std::set<std::string> kSensorKeys = {"rate_hz",
+                                           "leg_pot_noise_std_m",
+                                           "leg_adc_bits",
+                                           "gyro_noise_std_radps",
+                                           "gyro_bias_radps",
+                                           "accel_noise_std_mps2",
+                                           "accel_bias_mps2",
+                                           "imu_offset_m",
+                                           "has_orientation",
+                                           "orientation_noise_std_rad",
+                                           "seed",
+                                           "leg_scale",
+                                           "leg_offset_m",
+                                           "leg_nonlinearity_m",
+                                           "gyro_scale",
+                                           "accel_scale",
+                                           "imu_misalignment_deg"};
 const std::set<std::string> kLatencyKeys = {"sensor_ms", "command_ms"};
 const std::set<std::string> kInitialStateKeys = {"pose", "velocity"};
-const std::set<std::string> kDisturbanceKeys = {"constant_force_n", "constant_torque_nm", "steps",
-                                                "pulses",           "sinusoids",
-                                                "random_pushes"};
+const std::set<std::string> kDisturbanceKeys = {
+    "constant_force_n", "constant_torque_nm", "steps", "pulses", "sinusoids", "random_pushes"};
 // A whole stack config works as a truth: its other sections are not physics.
-const std::set<std::string> kIgnoredSections = {"controller", "safety",    "estimator",
-                                                "plant_sim",  "hw_bridge", "rates",
-                                                "lcm"};
+const std::set<std::string> kIgnoredSections = {"controller", "safety", "estimator", "plant_sim",
+                                                "hw_bridge",  "rates",  "lcm"};
 
 void CheckKeys(const YAML::Node& node, const std::string& path, const std::set<std::string>& keys) {
   if (!node.IsMap()) throw ConfigError(path, "expected a mapping");
@@ -87,8 +103,8 @@ Vector6d WrenchOf(const ConfigNode& node, const char* force_key, const char* tor
   return w;
 }
 
-void ApplyJointRadiusOffsets(const ConfigNode& platform, const YAML::Node& section,
-                             const char* key, Eigen::Matrix<double, 3, kNumLegs>* joints) {
+void ApplyJointRadiusOffsets(const ConfigNode& platform, const YAML::Node& section, const char* key,
+                             Eigen::Matrix<double, 3, kNumLegs>* joints) {
   if (!platform.Has(key)) return;
   const Vector6d offsets = VectorOrScalar<6>(platform, section, key, Vector6d::Zero());
   for (int i = 0; i < kNumLegs; ++i) {
@@ -174,9 +190,9 @@ PlantTruth ParsePlantTruth(const StackConfig& config, const YAML::Node& config_r
   // The sections a truth overrides, merged key by key into a copy of the config.
   YAML::Node merged = YAML::Clone(config_root);
   const std::vector<std::pair<std::string, const std::set<std::string>*>> sections = {
-      {"platform", &kPlatformKeys}, {"legs", &kLegKeys},
-      {"actuators", &kActuatorKeys}, {"sensors", &kSensorKeys},
-      {"latency", &kLatencyKeys},   {"initial_state", &kInitialStateKeys},
+      {"platform", &kPlatformKeys},      {"legs", &kLegKeys},
+      {"actuators", &kActuatorKeys},     {"sensors", &kSensorKeys},
+      {"latency", &kLatencyKeys},        {"initial_state", &kInitialStateKeys},
       {"disturbance", &kDisturbanceKeys}};
   for (const auto& item : truth) {
     const std::string section = item.first.as<std::string>();
@@ -209,7 +225,8 @@ PlantTruth ParsePlantTruth(const StackConfig& config, const YAML::Node& config_r
   ApplyJointRadiusOffsets(platform, platform_yaml, "platform_joint_radius_offsets_m",
                           &t.platform.platform_joints_in_P_m);
   if (platform.Has("payload")) {
-    CheckKeys(platform_yaml["payload"], "truth.platform.payload", {"mass_kg", "position_m", "box_m"});
+    CheckKeys(platform_yaml["payload"], "truth.platform.payload",
+              {"mass_kg", "position_m", "box_m"});
   }
   t.payload = ParsePayload(platform);
   t.platform = WithPayload(t.platform, t.payload);
@@ -233,7 +250,8 @@ PlantTruth ParsePlantTruth(const StackConfig& config, const YAML::Node& config_r
   SensorTruth& s = t.sensor_errors;
   s.leg_scale = PositiveVector<6>(sensors, sensors_yaml, "leg_scale", Vector6d::Ones());
   s.leg_offset_m = VectorOrScalar<6>(sensors, sensors_yaml, "leg_offset_m", Vector6d::Zero());
-  if (sensors.Has("leg_nonlinearity_m")) s.leg_nonlinearity_m = sensors.Double("leg_nonlinearity_m");
+  if (sensors.Has("leg_nonlinearity_m"))
+    s.leg_nonlinearity_m = sensors.Double("leg_nonlinearity_m");
   s.gyro_scale = PositiveVector<3>(sensors, sensors_yaml, "gyro_scale", Vector3d::Ones());
   s.accel_scale = PositiveVector<3>(sensors, sensors_yaml, "accel_scale", Vector3d::Ones());
   if (sensors.Has("imu_misalignment_deg")) {
@@ -248,8 +266,8 @@ PlantTruth ParsePlantTruth(const StackConfig& config, const YAML::Node& config_r
       (std::string(key) == "sensor_ms" ? t.latency.sensor_s : t.latency.command_s) = s_value;
     }
     if (t.latency.total_s() > kMaxLatencyS) {
-      latency.Fail("command_ms", "sensor_ms + command_ms must not exceed " +
-                                     Fmt(kMaxLatencyS * 1e3) + " ms");
+      latency.Fail("command_ms",
+                   "sensor_ms + command_ms must not exceed " + Fmt(kMaxLatencyS * 1e3) + " ms");
     }
   }
 

@@ -177,7 +177,8 @@ Vector6d ForwardDynamics(const DynamicsTerms& terms, const Vector6d& force_n,
 Vector6d GeneralisedForceOfWrench(const Vector6d& q, const Vector6d& wrench_in_B) {
   Vector6d out;
   out.head<3>() = wrench_in_B.head<3>();
-  out.tail<3>().noalias() = EulerRateMatrix(Vector3d(q.tail<3>())).transpose() * wrench_in_B.tail<3>();
+  out.tail<3>().noalias() =
+      EulerRateMatrix(Vector3d(q.tail<3>())).transpose() * wrench_in_B.tail<3>();
   return out;
 }
 

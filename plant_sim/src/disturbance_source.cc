@@ -22,8 +22,7 @@ DisturbanceSource::DisturbanceSource(const Disturbance& disturbance, unsigned ru
                disturbance.random_pushes.max_force_n > 0.0)),
       rng_((static_cast<std::uint64_t>(disturbance.random_pushes.seed) << 32) ^ run_seed) {
   if (disturbance_.random_pushes.rate_hz > 0.0) {
-    next_push_s_ =
-        std::exponential_distribution<double>(disturbance_.random_pushes.rate_hz)(rng_);
+    next_push_s_ = std::exponential_distribution<double>(disturbance_.random_pushes.rate_hz)(rng_);
   }
 }
 

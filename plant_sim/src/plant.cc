@@ -70,8 +70,8 @@ void Plant::ApplyForceCommand(const Vector6d& force_cmd_n) {
   inputs_.force_cmd_n = force_cmd_n;
   if (!(model_.actuators.force_lag_s > 0.0)) {
     // Without lag the motor force is the saturated command; the state keeps it for output.
-    x_.segment<6>(12) =
-        model_.actuator_errors.force_gain.cwiseProduct(SaturateForce(model_.actuators, force_cmd_n));
+    x_.segment<6>(12) = model_.actuator_errors.force_gain.cwiseProduct(
+        SaturateForce(model_.actuators, force_cmd_n));
   }
   MarkDiscontinuity();
 }

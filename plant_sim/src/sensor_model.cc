@@ -53,10 +53,10 @@ SensorReading SensorModel::Sample(const Vector6d& q, const Vector6d& qd, const V
                  sensors_.gyro_bias_radps;
   for (int i = 0; i < 3; ++i) r.gyro_radps(i) += sensors_.gyro_noise_std_radps * Gaussian();
 
-  r.accel_mps2 = errors_.accel_scale.cwiseProduct(
-                     imu_from_P_ *
-                     ImuSpecificForce(q, qd, qdd, sensors_.imu_offset_in_P_m, gravity_mps2_)) +
-                 sensors_.accel_bias_mps2;
+  r.accel_mps2 =
+      errors_.accel_scale.cwiseProduct(
+          imu_from_P_ * ImuSpecificForce(q, qd, qdd, sensors_.imu_offset_in_P_m, gravity_mps2_)) +
+      sensors_.accel_bias_mps2;
   for (int i = 0; i < 3; ++i) r.accel_mps2(i) += sensors_.accel_noise_std_mps2 * Gaussian();
 
   r.has_orientation = sensors_.has_orientation;

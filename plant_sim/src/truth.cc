@@ -18,13 +18,12 @@ PlatformParams WithPayload(const PlatformParams& platform, const Payload& payloa
   const double m = m_p + m_l;
   const Vector3d com = (m_p * platform.platform_com_in_P_m + m_l * payload.position_in_P_m) / m;
   const Vector3d& b = payload.box_m;
-  const Vector3d box_diagonal = m_l / 12.0 *
-                                Vector3d(b(1) * b(1) + b(2) * b(2), b(0) * b(0) + b(2) * b(2),
-                                         b(0) * b(0) + b(1) * b(1));
-  const Matrix3d inertia = PlatformInertiaInP(platform) +
-                           ParallelAxis(m_p, platform.platform_com_in_P_m - com) +
-                           Matrix3d(box_diagonal.asDiagonal()) +
-                           ParallelAxis(m_l, payload.position_in_P_m - com);
+  const Vector3d box_diagonal =
+      m_l / 12.0 *
+      Vector3d(b(1) * b(1) + b(2) * b(2), b(0) * b(0) + b(2) * b(2), b(0) * b(0) + b(1) * b(1));
+  const Matrix3d inertia =
+      PlatformInertiaInP(platform) + ParallelAxis(m_p, platform.platform_com_in_P_m - com) +
+      Matrix3d(box_diagonal.asDiagonal()) + ParallelAxis(m_l, payload.position_in_P_m - com);
   out.platform_mass_kg = m;
   out.platform_com_in_P_m = com;
   out.platform_inertia_kgm2 = inertia.diagonal();

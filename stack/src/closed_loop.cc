@@ -153,8 +153,7 @@ ClosedLoopSummary RunClosedLoop(const StackConfig& config, const Scenario& scena
       continue;
     }
     ControllerProcessOutput nominal;
-    const bool has_nominal =
-        controller.OnState(state, &nominal) == ControllerVerdict::kPublished;
+    const bool has_nominal = controller.OnState(state, &nominal) == ControllerVerdict::kPublished;
     // Safety sees the state first, then the nominal command derived from it
     // (always delivered: it shows the controller is alive). The plant, as in
     // lockstep, applies the first command that answers this sample.
@@ -196,9 +195,8 @@ ClosedLoopSummary RunClosedLoop(const StackConfig& config, const Scenario& scena
     }
     if (csv) {
       *csv << static_cast<double>(utime) * 1e-6;
-      const std::array<const Vector6d*, 6> columns{&q_true,  &qd_true,
-                                                   &state.q, &state.qd,
-                                                   &nominal.command.force_n, &f_safe};
+      const std::array<const Vector6d*, 6> columns{
+          &q_true, &qd_true, &state.q, &state.qd, &nominal.command.force_n, &f_safe};
       for (const Vector6d* v : columns)
         for (int i = 0; i < 6; ++i) *csv << ',' << (*v)(i);
       *csv << ',' << (d ? static_cast<int>(d->filter_case) : -1) << ','

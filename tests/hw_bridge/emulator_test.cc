@@ -6,9 +6,11 @@
 
 #include "stewart/config/truth_loader.h"
 #include "stewart/hw_bridge/bridge.h"
+#include "stewart/hw_bridge/drive_map.h"
 #include "stewart/hw_emulator/device_emulator.h"
 #include "stewart/hw_emulator/plant_backend.h"
 #include "stewart/hw_emulator/sample_schedule.h"
+#include "stewart/model/dynamics.h"
 #include "stewart/model/kinematics.h"
 #include "stewart/plant_sim/plant.h"
 #include "stewart/plant_sim/sensor_model.h"
@@ -323,6 +325,44 @@ TEST(PlantBackend, BridgePlusEmulatorEqualsPlantSim) {
   EXPECT_LT(max_dgyro, c.sensors.gyro_noise_std_radps);
   EXPECT_LE(max_daccel, 0.5 * c.hw_bridge.accel_mps2_per_lsb + 0.01);
   EXPECT_LT(max_daccel, c.sensors.accel_noise_std_mps2);
+}
+
+}  // namespace
+}  // namespace stewart::hw
+
+namespace stewart::hw {
+namespace {
+
+// The emulator's plant takes its physics from a truth: under the drive that
+// holds the model's platform, a platform 50 % heavier (friction off) sinks
+// by 1/2 a t^2 more, a from the truth's dynamics.
+TEST(PlantBackend, HeavierTruthSinksAtTheExpectedRate) {
+  const StackConfig& c = test::Config();
+  PlantTruth exact = TruthAtRest(c);
+  exact.actuators.viscous_friction_nspm = 0.0;
+  PlantTruth heavy = exact;
+  heavy.platform.platform_mass_kg *= 1.5;
+  PlantBackendOptions o;
+  o.noise = false;
+  o.power_on_settle_s = 0.0;
+  PlantBackend exact_backend(c, exact, o), heavy_backend(c, heavy, o);
+  const DriveMap drive_map(c.hw_bridge, c.actuators.force_limit_n);
+  const Vector6d hold_n = InverseDynamics(
+      EvaluateDynamics(c.platform, c.home_pose, Vector6d::Zero()), Vector6d::Zero());
+  const DriveArray drive = drive_map.ForceToDrive(hold_n).drive;
+  const Vector6d applied_n = drive_map.DriveToForce(drive);
+  constexpr double kT = 0.05;
+  constexpr int kSteps = 50;
+  for (int k = 0; k < kSteps; ++k) {
+    exact_backend.Step(drive, kT / kSteps);
+    heavy_backend.Step(drive, kT / kSteps);
+  }
+  auto qdd_z = [&](const PlatformParams& p) {
+    return ForwardDynamics(EvaluateDynamics(p, c.home_pose, Vector6d::Zero()), applied_n)(2);
+  };
+  const double expected = 0.5 * (qdd_z(heavy.platform) - qdd_z(exact.platform)) * kT * kT;
+  ASSERT_LT(expected, -1e-3);
+  EXPECT_NEAR(heavy_backend.q()(2) - exact_backend.q()(2), expected, 0.03 * std::abs(expected));
 }
 
 }  // namespace

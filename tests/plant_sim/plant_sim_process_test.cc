@@ -12,8 +12,10 @@
 
 #include "plant_test_util.h"
 #include "stewart/config/config_loader.h"
+#include "stewart/config/truth_loader.h"
 #include "stewart/force_command_t.hpp"
 #include "stewart/health_t.hpp"
+#include "stewart/model/dynamics.h"
 #include "stewart/model/kinematics.h"
 #include "stewart/node/lcm_handle.h"
 #include "stewart/sensor_t.hpp"
@@ -73,7 +75,9 @@ class Process {
 // sample with a leg-space P controller around the holding force.
 class Stack {
  public:
-  Stack(const std::string& url, bool answer) : lcm_(MakeLcm(url)), answer_(answer) {
+  /// hold_only: answer with the model's holding force alone (no feedback).
+  Stack(const std::string& url, bool answer, bool hold_only = false)
+      : lcm_(MakeLcm(url)), answer_(answer), hold_only_(hold_only) {
     const auto& ch = Config().lcm.channels;
     lcm_->subscribe(ch.sensors, &Stack::OnSensor, this)->setQueueCapacity(10000);
     lcm_->subscribe(ch.state_truth, &Stack::OnTruth, this)->setQueueCapacity(10000);
@@ -112,6 +116,10 @@ class Stack {
     if (!sensors.empty() && sensors.back().seq == s->seq) return;  // startup resend
     sensors.push_back(*s);
     if (!answer_) return;
+    if (hold_only_) {
+      PublishCommand(s->utime, hold_n_);
+      return;
+    }
     Vector6d l;
     for (int i = 0; i < 6; ++i) l(i) = s->leg_length_m[i];
     PublishCommand(s->utime, hold_n_ + 800.0 * (l_target_ - l));
@@ -127,6 +135,7 @@ class Stack {
 
   std::unique_ptr<lcm::LCM> lcm_;
   bool answer_;
+  bool hold_only_;
   int64_t cmd_seq_ = 0;
 };
 
@@ -188,6 +197,60 @@ TEST(PlantSimProcess, LockstepGivesByteIdenticalGroundTruth) {
   const auto b = LockstepRun(7702);
   ASSERT_EQ(a.size(), b.size());
   for (size_t i = 0; i < a.size(); ++i) ASSERT_EQ(a[i], b[i]) << "tick " << i;
+}
+
+// plant_sim --truth: a platform 50 % heavier than the model, held by the
+// model's holding force and nothing else, sinks with the acceleration the
+// truth's dynamics give (friction off in the truth, so it is the only
+// force besides gravity); without the truth it stays put.
+double SinkAfter(int port, const std::string& truth_path, double duration_s) {
+  const std::string url = PrivateLcmUrl(port);
+  Stack stack(url, true, /*hold_only=*/true);
+  std::vector<std::string> args = {"--lcm-url",   url,          "--mode",
+                                   "lockstep",    "--duration", std::to_string(duration_s),
+                                   "--log-level", "warn"};
+  if (!truth_path.empty()) {
+    args.push_back("--truth");
+    args.push_back(truth_path);
+  }
+  Process sim(args);
+  EXPECT_TRUE(sim.running());
+  stack.SpinUntilExit(&sim, 15.0);
+  EXPECT_EQ(sim.Wait(), 0);
+  if (stack.truth.empty()) return NAN;
+  return stack.truth.back().q[2] - Config().plant_sim.initial_pose(2);
+}
+
+TEST(PlantSimProcess, HeavierTruthSinksTheUncompensatedPlatformAtTheExpectedRate) {
+  const std::string truth_path = testing::TempDir() + "/heavier_truth.yaml";
+  const double mass_kg = 1.5 * Config().platform.platform_mass_kg;
+  std::ofstream(truth_path) << "platform: {mass_kg: " << mass_kg
+                            << "}\nactuators: {viscous_friction_nspm: 0.0}\n";
+  constexpr double kT = 0.05;  // short: the pose, hence M and G, barely change
+  const PlantTruth truth = LoadPlantTruth(Config(), truth_path);
+  const Vector6d q0 = Config().plant_sim.initial_pose;
+  const Vector6d qdd0 = ForwardDynamics(EvaluateDynamics(truth.platform, q0, Vector6d::Zero()),
+                                        test::HoldingForce(Config().platform, q0));
+  ASSERT_LT(qdd0(2), -1.0);  // it falls, at m/s^2
+  const double expected = 0.5 * qdd0(2) * kT * kT;
+  EXPECT_NEAR(SinkAfter(7705, truth_path, kT), expected, 0.03 * std::abs(expected));
+  EXPECT_NEAR(SinkAfter(7706, "", kT), 0.0, 1e-6);
+  std::remove(truth_path.c_str());
+}
+
+TEST(PlantSimProcess, BadTruthFileExitsNamingTheKey) {
+  const std::string truth_path = testing::TempDir() + "/bad_truth.yaml";
+  std::ofstream(truth_path) << "platform: {payload: {mass_kg: -1}}\n";
+  const std::string log_path = testing::TempDir() + "/bad_truth.log";
+  const std::string command = std::string(PLANT_SIM_BIN) + " --truth " + truth_path +
+                              " --mode lockstep --duration 0.1 > " + log_path + " 2>&1";
+  EXPECT_EQ(WEXITSTATUS(std::system(command.c_str())), 2);
+  std::ifstream in(log_path);
+  std::stringstream text;
+  text << in.rdbuf();
+  EXPECT_NE(text.str().find("truth.platform.payload.mass_kg"), std::string::npos) << text.str();
+  std::remove(truth_path.c_str());
+  std::remove(log_path.c_str());
 }
 
 TEST(PlantSimProcess, LockstepTimeoutExitsNamingWhatItWaitedFor) {

@@ -3,8 +3,8 @@
 // stewart_closed_loop_sim and by tests that need many closed-loop runs.
 #include <array>
 #include <cstdint>
-#include <ostream>
 #include <optional>
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -22,7 +22,7 @@ struct ClosedLoopOptions {
   bool no_filter = false;      ///< F* = F_des (to measure what the filter prevents)
   /// The reference solver for variant qp (must outlive the run); unused otherwise.
   safety::ReferenceQpSolver* reference = nullptr;
-  std::uint64_t seed = 1;      ///< sensor noise seed (overrides sensors.seed)
+  std::uint64_t seed = 1;  ///< sensor noise seed (overrides sensors.seed)
   /// The plant's physics; absent: the config's own (TruthOfConfig). The
   /// estimator, controller and filter always use `config`.
   std::optional<PlantTruth> truth;
@@ -46,18 +46,18 @@ struct ClosedLoopSummary {
   long ticks = 0;
   Vector6d q_max = Vector6d::Constant(-1e9), q_min = Vector6d::Constant(1e9);    ///< ground truth
   Vector6d qd_max = Vector6d::Constant(-1e9), qd_min = Vector6d::Constant(1e9);  ///< ground truth
-  double max_limit_excess = -1e9;     ///< largest excess of any configured limit (m or m/s)
-  std::string max_limit_excess_name;  ///< which limit, e.g. "xd upper"
+  double max_limit_excess = -1e9;          ///< largest excess of any configured limit (m or m/s)
+  std::string max_limit_excess_name;       ///< which limit, e.g. "xd upper"
   std::vector<LimitMargin> limit_margins;  ///< every limit, LimitNames order
-  std::string failure;  ///< why the run stopped early (plant integration), "" if it did not
-  double rms_q_error = 0.0;           ///< estimate vs truth, translations (m)
-  double rms_qd_error = 0.0;          ///< estimate vs truth, translational rates (m/s)
+  std::string failure;        ///< why the run stopped early (plant integration), "" if it did not
+  double rms_q_error = 0.0;   ///< estimate vs truth, translations (m)
+  double rms_qd_error = 0.0;  ///< estimate vs truth, translational rates (m/s)
   safety::FilterCaseCounts case_ticks{};  ///< ticks per FilterCase
   long infeasible_ticks = 0;
-  long fallback_ticks = 0;  ///< ticks the safety process answered with its fallback
-  long endstop_hits = 0;    ///< legs entering an end-stop (plant)
+  long fallback_ticks = 0;        ///< ticks the safety process answered with its fallback
+  long endstop_hits = 0;          ///< legs entering an end-stop (plant)
   long estimator_rejections = 0;  ///< sensor samples or updates the estimator rejected
-  long saturated_ticks = 0;  ///< ticks where |F*_i| exceeded the actuator force limit
+  long saturated_ticks = 0;       ///< ticks where |F*_i| exceeded the actuator force limit
   double max_force_n = 0.0;
   long estimator_reinits = 0;
   Vector6d q_final = Vector6d::Zero();

@@ -1,0 +1,30 @@
+#pragma once
+// What a campaign's runs.csv says, in numbers (summary.json) and words
+// (summary.md): violation rate and worst excess per limit with the run that
+// caused it, quantiles of the worst margin, tracking and estimator health.
+// Computed from the CSV alone, so merged shards summarise as one campaign.
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+namespace stewart {
+
+struct CsvTable {
+  std::vector<std::string> header;
+  std::vector<std::vector<std::string>> rows;
+  /// Index of a column; -1 when absent.
+  int Column(const std::string& name) const;
+  double Number(std::size_t row, int column) const;
+};
+
+/// Reads a CSV written by the campaign (RFC 4180 quoting). Throws InputError
+/// naming the file and line when a row has the wrong number of fields.
+CsvTable ReadCsv(const std::string& path);
+void WriteCsv(const std::string& path, const CsvTable& table);
+
+/// `meta` (campaign settings) is copied into the summary's "campaign" entry.
+nlohmann::json SummarizeCampaign(const CsvTable& runs, const nlohmann::json& meta,
+                                 double tolerance);
+std::string SummaryMarkdown(const nlohmann::json& summary);
+
+}  // namespace stewart

@@ -1,0 +1,210 @@
+#include "stewart/stack/campaign.h"
+
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <limits>
+#include <mutex>
+#include <sstream>
+#include <thread>
+
+#include "stewart/config/config_loader.h"
+#include "stewart/config/scenario_loader.h"
+#include "stewart/config/truth_loader.h"
+#include "stewart/stack/random_scenario.h"
+
+namespace stewart {
+namespace {
+
+std::uint64_t SplitMix64(std::uint64_t x) {
+  x += 0x9E3779B97F4A7C15ULL;
+  x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ULL;
+  x = (x ^ (x >> 27)) * 0x94D049BB133111EBULL;
+  return x ^ (x >> 31);
+}
+
+std::string Number(double v) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.17g", v);
+  return buffer;
+}
+
+// A CSV field: quoted when it holds a comma, quote or newline.
+std::string Field(const std::string& s) {
+  if (s.find_first_of(",\"\n") == std::string::npos) return s;
+  std::string out = "\"";
+  for (const char c : s) {
+    if (c == '"') out += '"';
+    out += c == '\n' ? ' ' : c;
+  }
+  return out + "\"";
+}
+
+}  // namespace
+
+std::uint32_t RunSeed(std::uint64_t campaign_seed, long index) {
+  return static_cast<std::uint32_t>(
+      SplitMix64(SplitMix64(campaign_seed) ^ static_cast<std::uint64_t>(index)) >> 32);
+}
+
+CampaignSpec MakeCampaignSpec(const std::string& config_path, const std::string& scenario,
+                              const std::string& distribution_path, std::uint64_t seed,
+                              double duration_s) {
+  CampaignSpec spec;
+  spec.config_path = config_path;
+  spec.config = LoadStackConfig(config_path);
+  spec.config_root = LoadYamlFile(config_path);
+  spec.scenario = scenario;
+  if (scenario != "random") LoadScenario(ResolveScenarioPath(scenario));  // fails early
+  spec.distribution_path = distribution_path;
+  if (!distribution_path.empty()) {
+    spec.distribution_yaml = LoadYamlFile(distribution_path);
+    spec.distribution = ParseDistribution(spec.distribution_yaml, spec.config_root);
+  }
+  spec.seed = seed;
+  if (!(duration_s >= 0.0)) throw InputError("--duration", "must not be negative");
+  spec.duration_s = duration_s;
+  // One draw now, so a distribution whose truths do not parse fails here,
+  // naming the key, rather than in every run.
+  SetUpRun(spec, 0);
+  return spec;
+}
+
+RunSetup SetUpRun(const CampaignSpec& spec, long index) {
+  RunSetup run;
+  run.index = index;
+  run.seed = RunSeed(spec.seed, index);
+  std::mt19937_64 rng(run.seed);
+  SampledTruth sampled = spec.distribution.parameters.empty()
+                             ? SampledTruth{YAML::Node(YAML::NodeType::Map), {}}
+                             : SampleTruth(spec.distribution, &rng);
+  run.truth_yaml = sampled.truth;
+  run.sampled = std::move(sampled.values);
+  if (spec.scenario == "random") {
+    const RandomRun random = MakeRandomRun(spec.config, spec.random_duration_s, &rng);
+    run.scenario = random.scenario;
+    run.scenario_yaml = random.scenario_yaml;
+    YAML::Node pose(YAML::NodeType::Sequence), velocity(YAML::NodeType::Sequence);
+    for (int a = 0; a < 6; ++a) {
+      pose.push_back(random.initial_pose(a));
+      velocity.push_back(random.initial_velocity(a));
+    }
+    pose.SetStyle(YAML::EmitterStyle::Flow);
+    velocity.SetStyle(YAML::EmitterStyle::Flow);
+    run.truth_yaml["initial_state"]["pose"] = pose;
+    run.truth_yaml["initial_state"]["velocity"] = velocity;
+  } else {
+    run.scenario = LoadScenario(ResolveScenarioPath(spec.scenario));
+  }
+  run.truth = ParsePlantTruth(spec.config, spec.config_root, run.truth_yaml);
+  run.duration_s = spec.duration_s > 0.0 ? spec.duration_s : run.scenario.duration_s();
+  return run;
+}
+
+CampaignRow RunCampaignRow(const CampaignSpec& spec, long index, std::ostream* trajectory) {
+  const auto started = std::chrono::steady_clock::now();
+  RunSetup run;
+  try {
+    run = SetUpRun(spec, index);
+  } catch (const std::exception& e) {
+    // A truth the distribution can draw but the plant cannot take: a failed
+    // row, reported, not a stopped campaign.
+    CampaignRow row;
+    row.index = index;
+    row.seed = RunSeed(spec.seed, index);
+    row.sampled.assign(spec.distribution.ColumnNames().size(),
+                       std::numeric_limits<double>::quiet_NaN());
+    for (std::string& name : LimitNames(spec.config.safety)) {
+      row.summary.limit_margins.push_back({name, std::numeric_limits<double>::quiet_NaN()});
+    }
+    row.summary.failure = std::string("setup: ") + e.what();
+    return row;
+  }
+  ClosedLoopOptions options;
+  options.duration_s = run.duration_s;
+  options.seed = run.seed;
+  options.truth = run.truth;
+  CampaignRow row;
+  row.index = index;
+  row.seed = run.seed;
+  row.sampled = run.sampled;
+  row.summary = RunClosedLoop(spec.config, run.scenario, options, trajectory);
+  row.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  return row;
+}
+
+std::vector<long> ShardIndices(long runs, int shard, int shards) {
+  if (shards < 1 || shard < 1 || shard > shards) {
+    throw InputError("--shard", "must be K/N with 1 <= K <= N, got " + std::to_string(shard) + "/" +
+                                    std::to_string(shards));
+  }
+  std::vector<long> indices;
+  for (long i = shard - 1; i < runs; i += shards) indices.push_back(i);
+  return indices;
+}
+
+CampaignSpec CloneSpec(const CampaignSpec& spec) {
+  CampaignSpec copy = spec;
+  copy.config_root = YAML::Clone(spec.config_root);
+  copy.distribution_yaml = YAML::Clone(spec.distribution_yaml);
+  for (ParameterSpec& p : copy.distribution.parameters) p.fixed = YAML::Clone(p.fixed);
+  return copy;
+}
+
+std::vector<std::string> RunCampaignLines(const CampaignSpec& spec,
+                                          const std::vector<long>& indices, int jobs,
+                                          const std::function<void(long done)>& progress) {
+  if (jobs < 1) throw InputError("--jobs", "must be at least 1");
+  std::vector<std::string> lines(indices.size());
+  std::atomic<std::size_t> next{0};
+  std::mutex mutex;  // guards the spec copies and progress
+  long done = 0;
+  auto work = [&] {
+    CampaignSpec local;
+    {
+      const std::lock_guard<std::mutex> lock(mutex);
+      local = CloneSpec(spec);
+    }
+    for (std::size_t i = next++; i < indices.size(); i = next++) {
+      lines[i] = CampaignCsvLine(local, RunCampaignRow(local, indices[i], nullptr));
+      const std::lock_guard<std::mutex> lock(mutex);
+      ++done;
+      if (progress) progress(done);
+    }
+  };
+  std::vector<std::thread> threads;
+  for (int j = 1; j < jobs; ++j) threads.emplace_back(work);
+  work();
+  for (std::thread& t : threads) t.join();
+  return lines;
+}
+
+std::vector<std::string> CampaignColumns(const CampaignSpec& spec) {
+  std::vector<std::string> columns = {"index", "seed", "scenario"};
+  for (const std::string& name : spec.distribution.ColumnNames()) columns.push_back(name);
+  const std::vector<std::string> limits = LimitNames(spec.config.safety);
+  for (const std::string& name : limits) columns.push_back(name + "_excess");
+  for (const std::string& name : limits) columns.push_back(name + "_margin");
+  for (const char* name : {"tracking_rms_m", "estimate_rms_m", "estimate_rms_mps",
+                           "estimator_restarts", "estimator_rejections", "fallback_ticks",
+                           "infeasible_ticks", "endstop_hits", "completed", "failure", "wall_s"}) {
+    columns.push_back(name);
+  }
+  return columns;
+}
+
+std::string CampaignCsvLine(const CampaignSpec& spec, const CampaignRow& row) {
+  const ClosedLoopSummary& s = row.summary;
+  std::ostringstream line;
+  line << row.index << ',' << row.seed << ',' << Field(spec.scenario);
+  for (const double v : row.sampled) line << ',' << Number(v);
+  for (const LimitMargin& m : s.limit_margins) line << ',' << Number(m.excess());
+  for (const LimitMargin& m : s.limit_margins) line << ',' << Number(m.worst_margin);
+  line << ',' << Number(s.rms_translation_tracking_inside_m) << ',' << Number(s.rms_q_error) << ','
+       << Number(s.rms_qd_error) << ',' << s.estimator_reinits << ',' << s.estimator_rejections
+       << ',' << s.fallback_ticks << ',' << s.infeasible_ticks << ',' << s.endstop_hits << ','
+       << (s.completed ? 1 : 0) << ',' << Field(s.failure) << ',' << Number(row.wall_s);
+  return line.str();
+}
+
+}  // namespace stewart

@@ -1,0 +1,301 @@
+#include "stewart/stack/campaign_summary.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <limits>
+#include <sstream>
+
+#include "stewart/common/check.h"
+
+namespace stewart {
+namespace {
+
+using nlohmann::json;
+
+std::vector<std::string> SplitCsvLine(const std::string& line) {
+  std::vector<std::string> fields;
+  std::string field;
+  bool quoted = false;
+  for (std::size_t i = 0; i < line.size(); ++i) {
+    const char c = line[i];
+    if (quoted) {
+      if (c == '"' && i + 1 < line.size() && line[i + 1] == '"') {
+        field += '"';
+        ++i;
+      } else if (c == '"') {
+        quoted = false;
+      } else {
+        field += c;
+      }
+    } else if (c == '"') {
+      quoted = true;
+    } else if (c == ',') {
+      fields.push_back(field);
+      field.clear();
+    } else {
+      field += c;
+    }
+  }
+  fields.push_back(field);
+  return fields;
+}
+
+std::string Quote(const std::string& s) {
+  if (s.find_first_of(",\"\n") == std::string::npos) return s;
+  std::string out = "\"";
+  for (const char c : s) {
+    if (c == '"') out += '"';
+    out += c;
+  }
+  return out + "\"";
+}
+
+double Quantile(std::vector<double> v, double p) {
+  if (v.empty()) return std::numeric_limits<double>::quiet_NaN();
+  std::sort(v.begin(), v.end());
+  const double pos = p * static_cast<double>(v.size() - 1);
+  const auto lo = static_cast<std::size_t>(std::floor(pos));
+  const std::size_t hi = std::min(lo + 1, v.size() - 1);
+  return v[lo] + (pos - static_cast<double>(lo)) * (v[hi] - v[lo]);
+}
+
+json Quantiles(const std::vector<double>& v) {
+  return json{{"min", Quantile(v, 0.0)},  {"p01", Quantile(v, 0.01)}, {"p05", Quantile(v, 0.05)},
+              {"p50", Quantile(v, 0.50)}, {"p95", Quantile(v, 0.95)}, {"max", Quantile(v, 1.0)}};
+}
+
+bool EndsWith(const std::string& s, const std::string& suffix) {
+  return s.size() >= suffix.size() &&
+         s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+// "xd_upper" is a velocity limit, "x_upper" a position limit.
+bool IsVelocityLimit(const std::string& name) {
+  const std::size_t underscore = name.find('_');
+  return underscore != std::string::npos && underscore >= 1 && name[underscore - 1] == 'd';
+}
+
+std::string Fmt(const char* format, double v) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, format, v);
+  return buffer;
+}
+
+}  // namespace
+
+int CsvTable::Column(const std::string& name) const {
+  const auto it = std::find(header.begin(), header.end(), name);
+  return it == header.end() ? -1 : static_cast<int>(it - header.begin());
+}
+
+double CsvTable::Number(std::size_t row, int column) const {
+  STEWART_CHECK(column >= 0 && static_cast<std::size_t>(column) < header.size(),
+                "CsvTable::Number: no such column");
+  const std::string& s = rows[row][static_cast<std::size_t>(column)];
+  if (s.empty()) return std::numeric_limits<double>::quiet_NaN();
+  return std::stod(s);
+}
+
+CsvTable ReadCsv(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path, "cannot open");
+  CsvTable table;
+  std::string line;
+  if (!std::getline(in, line)) throw InputError(path, "empty file, expected a CSV header");
+  table.header = SplitCsvLine(line);
+  for (long n = 2; std::getline(in, line); ++n) {
+    if (line.empty()) continue;
+    std::vector<std::string> fields = SplitCsvLine(line);
+    if (fields.size() != table.header.size()) {
+      throw InputError(path + ":" + std::to_string(n), "has " + std::to_string(fields.size()) +
+                                                           " fields, the header " +
+                                                           std::to_string(table.header.size()));
+    }
+    table.rows.push_back(std::move(fields));
+  }
+  return table;
+}
+
+void WriteCsv(const std::string& path, const CsvTable& table) {
+  std::ofstream out(path);
+  if (!out) throw InputError(path, "cannot write");
+  auto write = [&](const std::vector<std::string>& fields) {
+    for (std::size_t i = 0; i < fields.size(); ++i) out << (i ? "," : "") << Quote(fields[i]);
+    out << '\n';
+  };
+  write(table.header);
+  for (const auto& row : table.rows) write(row);
+}
+
+json SummarizeCampaign(const CsvTable& runs, const json& meta, double tolerance) {
+  json s;
+  s["campaign"] = meta;
+  const std::size_t n = runs.rows.size();
+  s["runs"] = n;
+  s["tolerance"] = tolerance;
+  const int index_col = runs.Column("index");
+  const int seed_col = runs.Column("seed");
+  auto run_id = [&](std::size_t r) {
+    return json{{"index", std::stol(runs.rows[r][static_cast<std::size_t>(index_col)])},
+                {"seed", std::stoul(runs.rows[r][static_cast<std::size_t>(seed_col)])}};
+  };
+  // Per limit: how often, how far, and who.
+  json limits = json::array();
+  std::vector<double> worst_position(n, 1e9), worst_velocity(n, 1e9);
+  for (std::size_t c = 0; c < runs.header.size(); ++c) {
+    const std::string& column = runs.header[c];
+    if (!EndsWith(column, "_excess")) continue;
+    const std::string name = column.substr(0, column.size() - 7);
+    const int margin_col = runs.Column(name + "_margin");
+    long exceeded = 0, beyond_tolerance = 0;
+    double worst = 0.0;
+    std::size_t worst_row = 0;
+    for (std::size_t r = 0; r < n; ++r) {
+      const double excess = runs.Number(r, static_cast<int>(c));
+      if (excess > 0.0) ++exceeded;
+      if (excess > tolerance) ++beyond_tolerance;
+      if (excess > worst) {
+        worst = excess;
+        worst_row = r;
+      }
+      if (margin_col >= 0) {
+        std::vector<double>& group = IsVelocityLimit(name) ? worst_velocity : worst_position;
+        group[r] = std::min(group[r], runs.Number(r, margin_col));
+      }
+    }
+    json entry{{"limit", name},
+               {"unit", IsVelocityLimit(name) ? "m/s" : "m"},
+               {"runs_exceeding", exceeded},
+               {"runs_beyond_tolerance", beyond_tolerance},
+               {"violation_rate", n ? static_cast<double>(beyond_tolerance) / n : 0.0},
+               {"worst_excess", worst}};
+    if (worst > 0.0) entry["worst_run"] = run_id(worst_row);
+    limits.push_back(entry);
+  }
+  s["limits"] = limits;
+  s["worst_position_margin_m"] = Quantiles(worst_position);
+  s["worst_velocity_margin_mps"] = Quantiles(worst_velocity);
+
+  auto column_values = [&](const char* name) {
+    std::vector<double> v;
+    const int c = runs.Column(name);
+    if (c < 0) return v;
+    for (std::size_t r = 0; r < n; ++r) {
+      const double x = runs.Number(r, c);
+      if (std::isfinite(x)) v.push_back(x);
+    }
+    return v;
+  };
+  auto count_positive = [&](const char* name) {
+    long k = 0;
+    for (const double x : column_values(name)) k += x > 0.0 ? 1 : 0;
+    return k;
+  };
+  auto total = [&](const char* name) {
+    double sum = 0.0;
+    for (const double x : column_values(name)) sum += x;
+    return sum;
+  };
+  s["tracking_rms_m"] = Quantiles(column_values("tracking_rms_m"));
+  s["estimate_rms_m"] = Quantiles(column_values("estimate_rms_m"));
+  s["runs_with_estimator_restarts"] = count_positive("estimator_restarts");
+  s["estimator_restarts"] = total("estimator_restarts");
+  s["estimator_rejections"] = total("estimator_rejections");
+  s["runs_with_fallback"] = count_positive("fallback_ticks");
+  s["runs_with_infeasible"] = count_positive("infeasible_ticks");
+  s["runs_with_endstop_hits"] = count_positive("endstop_hits");
+  s["endstop_hits"] = total("endstop_hits");
+  const std::vector<double> completed = column_values("completed");
+  json failed = json::array();
+  const int failure_col = runs.Column("failure");
+  for (std::size_t r = 0; r < n; ++r) {
+    if (runs.Number(r, runs.Column("completed")) > 0.5) continue;
+    json f = run_id(r);
+    if (failure_col >= 0) f["failure"] = runs.rows[r][static_cast<std::size_t>(failure_col)];
+    failed.push_back(f);
+  }
+  s["failed_runs"] = failed;
+  s["wall_s_total"] = total("wall_s");
+  s["wall_s_per_run"] = Quantiles(column_values("wall_s"));
+  // Any run beyond tolerance on any limit, or failed, or restarting: not held.
+  long held = 0;
+  for (std::size_t r = 0; r < n; ++r) {
+    bool ok = runs.Number(r, runs.Column("completed")) > 0.5 &&
+              runs.Number(r, runs.Column("estimator_restarts")) == 0.0;
+    for (std::size_t c = 0; c < runs.header.size(); ++c) {
+      if (EndsWith(runs.header[c], "_excess") && runs.Number(r, static_cast<int>(c)) > tolerance) {
+        ok = false;
+      }
+    }
+    held += ok ? 1 : 0;
+  }
+  s["runs_held"] = held;
+  return s;
+}
+
+std::string SummaryMarkdown(const json& s) {
+  std::ostringstream o;
+  const json& meta = s["campaign"];
+  o << "# Campaign summary\n\n";
+  o << "| setting | value |\n| --- | --- |\n";
+  for (auto it = meta.begin(); it != meta.end(); ++it) {
+    o << "| " << it.key() << " | " << (it->is_string() ? it->get<std::string>() : it->dump())
+      << " |\n";
+  }
+  const double tol = s["tolerance"].get<double>();
+  o << "\n"
+    << s["runs"].get<long>() << " runs; " << s["runs_held"].get<long>()
+    << " held every limit within " << Fmt("%g", tol * 1e3)
+    << " mm (mm/s), completed and without estimator restart.\n\n";
+  o << "## Limits on ground truth\n\n";
+  o << "| limit | runs exceeding | beyond tolerance | violation rate | worst excess | worst run "
+       "(index, seed) |\n| --- | --- | --- | --- | --- | --- |\n";
+  for (const json& l : s["limits"]) {
+    const std::string unit = l["unit"].get<std::string>() == "m" ? "mm" : "mm/s";
+    o << "| " << l["limit"].get<std::string>() << " | " << l["runs_exceeding"].get<long>() << " | "
+      << l["runs_beyond_tolerance"].get<long>() << " | "
+      << Fmt("%.2f %%", 100.0 * l["violation_rate"].get<double>()) << " | "
+      << Fmt("%.3f", 1e3 * l["worst_excess"].get<double>()) << " " << unit << " | ";
+    if (l.contains("worst_run")) {
+      o << l["worst_run"]["index"].get<long>() << ", "
+        << l["worst_run"]["seed"].get<unsigned long>();
+    } else {
+      o << "-";
+    }
+    o << " |\n";
+  }
+  auto quantile_row = [&](const char* label, const json& q, double scale, const char* unit) {
+    o << "| " << label << " (" << unit << ") |";
+    for (const char* k : {"min", "p01", "p05", "p50", "p95", "max"}) {
+      o << " " << Fmt("%.4g", scale * q[k].get<double>()) << " |";
+    }
+    o << "\n";
+  };
+  o << "\n## Distributions over runs\n\n| quantity | min | 1 % | 5 % | median | 95 % | max |\n"
+       "| --- | --- | --- | --- | --- | --- | --- |\n";
+  quantile_row("worst position margin", s["worst_position_margin_m"], 1e3, "mm");
+  quantile_row("worst velocity margin", s["worst_velocity_margin_mps"], 1e3, "mm/s");
+  quantile_row("tracking rms, setpoints inside the limits", s["tracking_rms_m"], 1e3, "mm");
+  quantile_row("estimate rms, translation", s["estimate_rms_m"], 1e3, "mm");
+  quantile_row("wall time per run", s["wall_s_per_run"], 1.0, "s");
+  o << "\n## Health\n\n";
+  o << "- estimator restarts: " << s["estimator_restarts"].get<double>() << " in "
+    << s["runs_with_estimator_restarts"].get<long>() << " runs; rejected samples "
+    << s["estimator_rejections"].get<double>() << "\n";
+  o << "- runs with fallback ticks: " << s["runs_with_fallback"].get<long>()
+    << "; with infeasible ticks: " << s["runs_with_infeasible"].get<long>()
+    << "; with end-stop hits: " << s["runs_with_endstop_hits"].get<long>() << " ("
+    << s["endstop_hits"].get<double>() << " hits)\n";
+  o << "- failed runs: " << s["failed_runs"].size() << "\n";
+  for (const json& f : s["failed_runs"]) {
+    o << "  - index " << f["index"].get<long>() << ", seed " << f["seed"].get<unsigned long>()
+      << ": " << (f.contains("failure") ? f["failure"].get<std::string>() : "") << "\n";
+  }
+  o << "- wall time: " << Fmt("%.1f", s["wall_s_total"].get<double>())
+    << " s of run time in total\n";
+  return o.str();
+}
+
+}  // namespace stewart

@@ -1,0 +1,93 @@
+#include "stewart/stack/random_scenario.h"
+
+#include <algorithm>
+#include <sstream>
+
+#include "stewart/config/scenario_loader.h"
+#include "stewart/model/kinematics.h"
+
+namespace stewart {
+namespace {
+
+// Room kept from the stroke ends for a random pose (m): the controller's
+// overshoot must not put a leg into an end-stop.
+constexpr double kStrokeMarginM = 0.01;
+// Attempts to find a pose inside the stroke before giving up (the sampling box
+// is mostly inside, so a handful suffice).
+constexpr int kMaxAttempts = 1000;
+// Setpoint ranges around home: translations (m) and rotations (rad).
+constexpr double kTranslationRangeM = 0.15;
+constexpr double kZRangeM = 0.16;
+constexpr double kRotationRangeRad = 0.08;
+
+bool InsideStroke(const StackConfig& c, const Vector6d& q) {
+  const Vector6d l = InverseKinematics(c.platform, q);
+  return (l.array() > c.platform.leg_min_length_m + kStrokeMarginM).all() &&
+         (l.array() < c.platform.leg_max_length_m - kStrokeMarginM).all();
+}
+
+bool InsideLimits(const SafetyConfig& s, const Vector6d& q, double margin) {
+  for (const PositionLimitConfig& l : s.position_limits) {
+    if (l.upper && q(l.axis) > *l.upper - margin) return false;
+    if (l.lower && q(l.axis) < *l.lower + margin) return false;
+  }
+  return true;
+}
+
+Vector6d RandomPose(const StackConfig& c, std::mt19937_64* rng, bool inside_limits) {
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  for (int attempt = 0; attempt < kMaxAttempts; ++attempt) {
+    Vector6d q = c.home_pose;
+    q(0) += kTranslationRangeM * unit(*rng);
+    q(1) += kTranslationRangeM * unit(*rng);
+    q(2) += kZRangeM * unit(*rng);
+    for (int a = 3; a < 6; ++a) q(a) += kRotationRangeRad * unit(*rng);
+    if (InsideStroke(c, q) && (!inside_limits || InsideLimits(c.safety, q, 0.005))) return q;
+  }
+  return c.home_pose;
+}
+
+}  // namespace
+
+RandomRun MakeRandomRun(const StackConfig& config, double duration_s, std::mt19937_64* rng) {
+  RandomRun run;
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  // 3 to 8 steps of random length; every pose inside the stroke, each one
+  // inside or beyond the limits as it falls.
+  const int steps = 3 + static_cast<int>(unit(*rng) * 6.0);
+  std::vector<double> starts{0.0};
+  for (int i = 1; i < steps; ++i) starts.push_back(unit(*rng) * duration_s);
+  std::sort(starts.begin(), starts.end());
+  YAML::Node yaml;
+  yaml["name"] = "random";
+  yaml["description"] = "random setpoint steps inside and beyond the limits";
+  yaml["duration_s"] = duration_s;
+  YAML::Node segments(YAML::NodeType::Sequence);
+  for (int i = 0; i <= steps; ++i) {
+    const bool last = i == steps;
+    const Vector6d q_des = last ? config.home_pose : RandomPose(config, rng, false);
+    YAML::Node segment;
+    segment["start_s"] = last ? duration_s : starts[static_cast<size_t>(i)];
+    segment["type"] = "step";
+    YAML::Node q(YAML::NodeType::Sequence);
+    for (int a = 0; a < 6; ++a) q.push_back(q_des(a));
+    q.SetStyle(YAML::EmitterStyle::Flow);
+    segment["q_des"] = q;
+    segment.SetStyle(YAML::EmitterStyle::Flow);
+    segments.push_back(segment);
+  }
+  yaml["segments"] = segments;
+  run.scenario_yaml = yaml;
+  std::ostringstream text;
+  text << yaml;
+  run.scenario = ParseScenario(text.str(), "random");
+
+  run.initial_pose = RandomPose(config, rng, true);
+  for (const VelocityLimitConfig& l : config.safety.velocity_limits) {
+    const double bound = 0.5 * std::min(l.upper ? *l.upper : 1e9, l.lower ? -*l.lower : 1e9);
+    run.initial_velocity(l.axis) = bound * (2.0 * unit(*rng) - 1.0);
+  }
+  return run;
+}
+
+}  // namespace stewart

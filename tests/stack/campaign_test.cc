@@ -1,0 +1,160 @@
+// The Monte-Carlo campaign (docs/campaign.md): a row is a function of the
+// campaign and its index alone (any shard, any number of threads), the
+// summary reads what the rows say, and bad distribution files are named.
+#include "stewart/stack/campaign.h"
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "stewart/config/config_loader.h"
+#include "stewart/stack/campaign_summary.h"
+
+namespace stewart {
+namespace {
+
+const std::string kBounds = std::string(STEWART_SOURCE_DIR) + "/config/campaigns/bounds.yaml";
+
+// Short runs keep the test fast; 1.5 s covers the estimator's settling and
+// a setpoint step.
+CampaignSpec Spec(const std::string& scenario, const std::string& mismatch) {
+  return MakeCampaignSpec(DefaultConfigPath(), scenario, mismatch, 7, 1.5);
+}
+
+// Every field but the last (wall time).
+std::string WithoutWallTime(const std::string& line) { return line.substr(0, line.rfind(',')); }
+
+TEST(Campaign, RowsAreTheSameWithAnyJobsAndShards) {
+  CampaignSpec spec = Spec("random", kBounds);
+  spec.random_duration_s = 1.5;
+  const std::vector<long> all = ShardIndices(6, 1, 1);
+  const std::vector<std::string> one_job = RunCampaignLines(spec, all, 1, nullptr);
+  const std::vector<std::string> two_jobs = RunCampaignLines(spec, all, 2, nullptr);
+  ASSERT_EQ(one_job.size(), 6u);
+  for (std::size_t i = 0; i < all.size(); ++i) {
+    EXPECT_EQ(WithoutWallTime(one_job[i]), WithoutWallTime(two_jobs[i])) << "run " << i;
+  }
+  // Shards 1/2 and 2/2 hold the even and odd indices, with the same rows.
+  for (int shard = 1; shard <= 2; ++shard) {
+    const std::vector<long> indices = ShardIndices(6, shard, 2);
+    ASSERT_EQ(indices.size(), 3u);
+    const std::vector<std::string> lines = RunCampaignLines(spec, indices, 1, nullptr);
+    for (std::size_t k = 0; k < indices.size(); ++k) {
+      EXPECT_EQ(indices[k] % 2, shard - 1);
+      EXPECT_EQ(WithoutWallTime(lines[k]),
+                WithoutWallTime(one_job[static_cast<std::size_t>(indices[k])]));
+    }
+  }
+  // Different runs drew different plants.
+  EXPECT_NE(WithoutWallTime(one_job[0]), WithoutWallTime(one_job[1]));
+}
+
+TEST(Campaign, ShardMustBeInRange) {
+  EXPECT_THROW(ShardIndices(10, 0, 2), InputError);
+  EXPECT_THROW(ShardIndices(10, 3, 2), InputError);
+}
+
+TEST(Campaign, SampledValuesReachTheTruth) {
+  const CampaignSpec spec = Spec("paper", kBounds);
+  const RunSetup run = SetUpRun(spec, 3);
+  const std::vector<std::string> names = spec.distribution.ColumnNames();
+  ASSERT_EQ(names.size(), run.sampled.size());
+  const auto value = [&](const std::string& name) {
+    for (std::size_t i = 0; i < names.size(); ++i)
+      if (names[i] == name) return run.sampled[i];
+    ADD_FAILURE() << "no column " << name;
+    return 0.0;
+  };
+  EXPECT_EQ(run.truth.payload.mass_kg, value("platform.payload.mass_kg"));
+  EXPECT_EQ(run.truth.actuator_errors.force_gain(2), value("actuators.force_gain[2]"));
+  EXPECT_DOUBLE_EQ(run.truth.latency.command_s, 1e-3 * value("latency.command_ms"));
+  const double scale = value("platform.mass_kg");  // a scale: the mass is config x scale
+  EXPECT_GE(scale, 0.8 * spec.config.platform.platform_mass_kg);
+  EXPECT_LE(scale, 1.5 * spec.config.platform.platform_mass_kg);
+  EXPECT_DOUBLE_EQ(run.truth.platform.platform_mass_kg, scale + run.truth.payload.mass_kg);
+  EXPECT_GT(run.truth.disturbance.random_pushes.max_force_n, 0.0);
+}
+
+// The exact model, a short paper run: every limit held on ground truth, and
+// the summary counts what the rows hold.
+TEST(Campaign, ExactModelHoldsAndSummaryAgreesWithTheRows) {
+  const CampaignSpec spec = Spec("paper", "");
+  const std::vector<std::string> lines = RunCampaignLines(spec, ShardIndices(2, 1, 1), 2, nullptr);
+  const std::string dir = testing::TempDir() + "/campaign_summary_test";
+  std::filesystem::create_directories(dir);
+  {
+    std::ofstream csv(dir + "/runs.csv");
+    const std::vector<std::string> columns = CampaignColumns(spec);
+    for (std::size_t i = 0; i < columns.size(); ++i) csv << (i ? "," : "") << columns[i];
+    csv << '\n';
+    for (const std::string& l : lines) csv << l << '\n';
+  }
+  const CsvTable table = ReadCsv(dir + "/runs.csv");
+  ASSERT_EQ(table.rows.size(), 2u);
+  const nlohmann::json s = SummarizeCampaign(table, {{"scenario", "paper"}}, 1e-3);
+  EXPECT_EQ(s["runs"], 2);
+  EXPECT_EQ(s["runs_held"], 2);
+  EXPECT_EQ(s["failed_runs"].size(), 0u);
+  EXPECT_GT(s["worst_position_margin_m"]["min"].get<double>(), 0.0);
+  for (const auto& limit : s["limits"]) EXPECT_EQ(limit["runs_beyond_tolerance"], 0);
+  // A row edited to exceed x by 2 mm is counted, and named.
+  CsvTable edited = table;
+  edited.rows[1][static_cast<std::size_t>(edited.Column("x_upper_excess"))] = "0.002";
+  const nlohmann::json e = SummarizeCampaign(edited, {}, 1e-3);
+  EXPECT_EQ(e["runs_held"], 1);
+  EXPECT_EQ(e["limits"][0]["limit"], "x_upper");
+  EXPECT_EQ(e["limits"][0]["runs_beyond_tolerance"], 1);
+  EXPECT_EQ(e["limits"][0]["worst_run"]["index"], 1);
+  std::filesystem::remove_all(dir);
+}
+
+struct BadDistribution {
+  const char* yaml;
+  const char* key;
+};
+
+class CampaignRejects : public ::testing::TestWithParam<BadDistribution> {};
+
+TEST_P(CampaignRejects, NamingTheKey) {
+  const std::string path = testing::TempDir() + "/bad_distribution.yaml";
+  {
+    std::ofstream out(path);
+    out << GetParam().yaml;
+  }
+  try {
+    Spec("paper", path);
+    FAIL() << "accepted: " << GetParam().yaml;
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(GetParam().key), std::string::npos) << e.what();
+  }
+  std::remove(path.c_str());
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Cases, CampaignRejects,
+    ::testing::Values(
+        BadDistribution{"parameters: [{key: controller.kp, uniform: [0, 1]}]",
+                        "campaign.parameters[0].key"},
+        BadDistribution{"parameters: [{key: platform.mass_kg}]", "campaign.parameters[0].key"},
+        BadDistribution{"parameters: [{key: platform.mass_kg, uniform: [2, 1]}]",
+                        "campaign.parameters[0].uniform"},
+        BadDistribution{"parameters: [{key: platform.mass_kg, normal: [1, -1]}]",
+                        "campaign.parameters[0].normal"},
+        BadDistribution{"parameters: [{key: platform.mass_kg, uniform: [1]}]",
+                        "campaign.parameters[0].uniform"},
+        BadDistribution{"parameters: [{key: platform.payload.mass_kg, scale_uniform: [1, 2]}]",
+                        "campaign.parameters[0].key"},
+        BadDistribution{"parameters: [{key: actuators.force_gain, size: 9, uniform: [1, 2]}]",
+                        "campaign.parameters[0].size"},
+        // Drawn values the truth cannot take: the truth's key is named.
+        BadDistribution{"parameters: [{key: platform.mass_kg, uniform: [-2, -1]}]",
+                        "truth.platform.mass_kg"},
+        BadDistribution{"parameters: [{key: platform.wheels, uniform: [1, 2]}]",
+                        "truth.platform.wheels"},
+        BadDistribution{"parameters: 3", "campaign.parameters"}));
+
+}  // namespace
+}  // namespace stewart

@@ -1,0 +1,109 @@
+// stewart_campaign as a user runs it: a campaign folder, the same rows from
+// shards run by GNU parallel and merged, one row re-run alone and emitted as
+// a truth file, and one clear error for a bad distribution file.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "stewart/stack/campaign_summary.h"
+
+namespace stewart {
+namespace {
+
+namespace fs = std::filesystem;
+
+int Shell(const std::string& command) {
+  const int status = std::system(command.c_str());
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+std::string ReadText(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// Every column but the wall time.
+void ExpectSameRows(const CsvTable& a, const CsvTable& b) {
+  ASSERT_EQ(a.header, b.header);
+  ASSERT_EQ(a.rows.size(), b.rows.size());
+  const auto wall = static_cast<std::size_t>(a.Column("wall_s"));
+  for (std::size_t r = 0; r < a.rows.size(); ++r) {
+    for (std::size_t c = 0; c < a.header.size(); ++c) {
+      if (c == wall) continue;
+      EXPECT_EQ(a.rows[r][c], b.rows[r][c]) << a.header[c] << " row " << r;
+    }
+  }
+}
+
+class CampaignCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = testing::TempDir() + "/campaign_cli_" + std::to_string(::getpid());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override {
+    if (!HasFailure()) fs::remove_all(dir_);
+  }
+  std::string dir_;
+  const std::string bin_ = CAMPAIGN_PATH;
+  const std::string common_ = " --runs 4 --duration 1 --scenario random --seed 3 --mismatch " +
+                              std::string(STEWART_SOURCE_DIR) + "/config/campaigns/bounds.yaml";
+};
+
+TEST_F(CampaignCli, ParallelShardsMergeToTheSameRowsAndARowReruns) {
+  const std::string a = dir_ + "/a";
+  ASSERT_EQ(
+      Shell(bin_ + common_ + " --jobs 2 --no-plots --out " + a + " > " + dir_ + "/a.out 2>&1"), 0)
+      << ReadText(dir_ + "/a.out");
+  for (const char* file : {"runs.csv", "summary.json", "summary.md", "campaign.json", "config.yaml",
+                           "mismatch.yaml"}) {
+    EXPECT_TRUE(fs::exists(a + "/" + file)) << file;
+  }
+  const CsvTable direct = ReadCsv(a + "/runs.csv");
+  ASSERT_EQ(direct.rows.size(), 4u);
+
+  const std::string b = dir_ + "/b";
+  ASSERT_EQ(Shell("STEWART_BUILD_DIR=" + std::string(STEWART_BUILD_DIR) + " " + STEWART_SOURCE_DIR +
+                  "/tools/campaign_parallel.sh " + b + " 3 -j 2 --" + common_ + " > " + dir_ +
+                  "/b.out 2>&1"),
+            0)
+      << ReadText(dir_ + "/b.out");
+  ExpectSameRows(direct, ReadCsv(b + "/runs.csv"));
+  EXPECT_NE(ReadText(b + "/summary.md").find("4 runs;"), std::string::npos);
+
+  // Row 2 alone: its trajectory, the same row, its truth and launch line.
+  const std::string out = dir_ + "/rerun.out";
+  ASSERT_EQ(Shell(bin_ + " --rerun " + a + " --row 2 --emit-truth > " + out + " 2>&1"), 0)
+      << ReadText(out);
+  const std::string text = ReadText(out);
+  EXPECT_NE(text.find("identical to its row"), std::string::npos) << text;
+  EXPECT_NE(text.find("tools/launch.sh --config"), std::string::npos) << text;
+  EXPECT_TRUE(fs::exists(a + "/run_2.csv"));
+  EXPECT_TRUE(fs::exists(a + "/run_2_truth.yaml"));
+  EXPECT_TRUE(fs::exists(a + "/run_2_scenario.yaml"));
+  EXPECT_NE(ReadText(a + "/run_2_truth.yaml").find("initial_state"), std::string::npos);
+}
+
+TEST_F(CampaignCli, BadDistributionExitsTwoNamingTheKey) {
+  const std::string bad = dir_ + "/bad.yaml";
+  std::ofstream(bad) << "parameters:\n  - {key: actuators.force_gain, uniform: [1.1, 0.9]}\n";
+  const std::string out = dir_ + "/bad.out";
+  EXPECT_EQ(
+      Shell(bin_ + " --runs 2 --mismatch " + bad + " --out " + dir_ + "/c > " + out + " 2>&1"), 2);
+  EXPECT_NE(ReadText(out).find("campaign.parameters[0].uniform"), std::string::npos)
+      << ReadText(out);
+  EXPECT_EQ(Shell(bin_ + " --runs 2 --shard 3/2 --out " + dir_ + "/d > " + out + " 2>&1"), 2);
+  EXPECT_NE(ReadText(out).find("--shard"), std::string::npos) << ReadText(out);
+}
+
+}  // namespace
+}  // namespace stewart
