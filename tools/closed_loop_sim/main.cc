@@ -14,6 +14,7 @@
 
 #include "stewart/config/config_loader.h"
 #include "stewart/config/scenario_loader.h"
+#include "stewart/config/truth_loader.h"
 #include "stewart/controller/scenario.h"
 #include "stewart/safety/clp_reference_qp.h"
 #include "stewart/stack/closed_loop.h"
@@ -26,7 +27,7 @@ int main(int argc, char** argv) {
   std::string csv_path;
   ClosedLoopOptions options;
   std::optional<double> duration_s, k_velocity, k_position;
-  std::string variant;
+  std::string variant, truth_path;
   app.add_option("--config", config_path, "stack YAML config")->check(CLI::ExistingFile);
   app.add_option("--scenario", scenario_name, "scenario name or path");
   app.add_option("--duration", duration_s, "seconds (default: the scenario's)");
@@ -36,6 +37,9 @@ int main(int argc, char** argv) {
   app.add_option("--k-position", k_position, "override safety.k_position");
   app.add_option("--variant", variant, kSafetyVariantNames.Names() + " (qp: Clp reference)");
   app.add_flag("--no-filter", options.no_filter, "pass F_des through (to see what it prevents)");
+  app.add_option("--truth", truth_path,
+                 "the plant's physics differ from the config (docs/simulation.md, \"Truth\")")
+      ->check(CLI::ExistingFile);
   app.add_option("--csv", csv_path, "write t, q, qd, q_est, qd_est, F_des, F*, case per tick");
   CLI11_PARSE(app, argc, argv);
 
@@ -44,6 +48,7 @@ int main(int argc, char** argv) {
     if (k_velocity) config.safety.k_velocity = *k_velocity;
     if (k_position) config.safety.k_position = *k_position;
     if (!variant.empty()) config.safety.variant = ParseSafetyVariant(variant);
+    if (!truth_path.empty()) options.truth = LoadPlantTruth(config, truth_path);
     const Scenario scenario = LoadScenario(ResolveScenarioPath(scenario_name));
     options.duration_s = duration_s.value_or(scenario.duration_s());
     std::unique_ptr<std::ofstream> csv;
