@@ -93,6 +93,27 @@ TEST_F(CampaignCli, ParallelShardsMergeToTheSameRowsAndARowReruns) {
   EXPECT_NE(ReadText(a + "/run_2_truth.yaml").find("initial_state"), std::string::npos);
 }
 
+// tools/campaign_slurm.sbatch as a job array on the machine's Slurm (skipped
+// without a controller that answers; tools/slurm_local.sh sets one up): the
+// merged shards hold the rows of a direct run.
+TEST_F(CampaignCli, SlurmJobArrayShardsMergeToTheSameRows) {
+  if (Shell("sinfo -h > /dev/null 2>&1") != 0) {
+    GTEST_SKIP() << "no Slurm controller answers (tools/slurm_local.sh starts one)";
+  }
+  const std::string a = dir_ + "/a", c = dir_ + "/c";
+  ASSERT_EQ(Shell(bin_ + common_ + " --jobs 1 --no-plots --out " + a + " > /dev/null 2>&1"), 0);
+  const std::string submit = "cd " + std::string(STEWART_SOURCE_DIR) +
+                             " && STEWART_BUILD_DIR=" + STEWART_BUILD_DIR +
+                             " sbatch --parsable --wait --array=1-2 --chdir=" + dir_ +
+                             " tools/campaign_slurm.sbatch " + c + common_ + " > " + dir_ +
+                             "/sbatch.out 2>&1";
+  ASSERT_EQ(Shell(submit), 0) << ReadText(dir_ + "/sbatch.out");
+  ASSERT_EQ(Shell(bin_ + " --merge " + c + "/shard_1 " + c + "/shard_2 --no-plots --out " + c +
+                  " > /dev/null 2>&1"),
+            0);
+  ExpectSameRows(ReadCsv(a + "/runs.csv"), ReadCsv(c + "/runs.csv"));
+}
+
 TEST_F(CampaignCli, BadDistributionExitsTwoNamingTheKey) {
   const std::string bad = dir_ + "/bad.yaml";
   std::ofstream(bad) << "parameters:\n  - {key: actuators.force_gain, uniform: [1.1, 0.9]}\n";
