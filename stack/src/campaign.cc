@@ -11,6 +11,7 @@
 #include "stewart/config/config_loader.h"
 #include "stewart/config/scenario_loader.h"
 #include "stewart/config/truth_loader.h"
+#include "stewart/stack/campaign_summary.h"
 #include "stewart/stack/random_scenario.h"
 
 namespace stewart {
@@ -27,17 +28,6 @@ std::string Number(double v) {
   char buffer[32];
   std::snprintf(buffer, sizeof buffer, "%.17g", v);
   return buffer;
-}
-
-// A CSV field: quoted when it holds a comma, quote or newline.
-std::string Field(const std::string& s) {
-  if (s.find_first_of(",\"\n") == std::string::npos) return s;
-  std::string out = "\"";
-  for (const char c : s) {
-    if (c == '"') out += '"';
-    out += c == '\n' ? ' ' : c;
-  }
-  return out + "\"";
 }
 
 }  // namespace
@@ -196,14 +186,14 @@ std::vector<std::string> CampaignColumns(const CampaignSpec& spec) {
 std::string CampaignCsvLine(const CampaignSpec& spec, const CampaignRow& row) {
   const ClosedLoopSummary& s = row.summary;
   std::ostringstream line;
-  line << row.index << ',' << row.seed << ',' << Field(spec.scenario);
+  line << row.index << ',' << row.seed << ',' << CsvField(spec.scenario);
   for (const double v : row.sampled) line << ',' << Number(v);
   for (const LimitMargin& m : s.limit_margins) line << ',' << Number(m.excess());
   for (const LimitMargin& m : s.limit_margins) line << ',' << Number(m.worst_margin);
   line << ',' << Number(s.rms_translation_tracking_inside_m) << ',' << Number(s.rms_q_error) << ','
        << Number(s.rms_qd_error) << ',' << s.estimator_reinits << ',' << s.estimator_rejections
        << ',' << s.fallback_ticks << ',' << s.infeasible_ticks << ',' << s.endstop_hits << ','
-       << (s.completed ? 1 : 0) << ',' << Field(s.failure) << ',' << Number(row.wall_s);
+       << (s.completed ? 1 : 0) << ',' << CsvField(s.failure) << ',' << Number(row.wall_s);
   return line.str();
 }
 

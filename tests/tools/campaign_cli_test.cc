@@ -102,11 +102,10 @@ TEST_F(CampaignCli, SlurmJobArrayShardsMergeToTheSameRows) {
   }
   const std::string a = dir_ + "/a", c = dir_ + "/c";
   ASSERT_EQ(Shell(bin_ + common_ + " --jobs 1 --no-plots --out " + a + " > /dev/null 2>&1"), 0);
-  const std::string submit = "cd " + std::string(STEWART_SOURCE_DIR) +
-                             " && STEWART_BUILD_DIR=" + STEWART_BUILD_DIR +
-                             " sbatch --parsable --wait --array=1-2 --chdir=" + dir_ +
-                             " tools/campaign_slurm.sbatch " + c + common_ + " > " + dir_ +
-                             "/sbatch.out 2>&1";
+  const std::string submit =
+      "cd " + std::string(STEWART_SOURCE_DIR) + " && STEWART_BUILD_DIR=" + STEWART_BUILD_DIR +
+      " sbatch --parsable --wait --array=1-2 --chdir=" + dir_ + " tools/campaign_slurm.sbatch " +
+      c + common_ + " > " + dir_ + "/sbatch.out 2>&1";
   ASSERT_EQ(Shell(submit), 0) << ReadText(dir_ + "/sbatch.out");
   ASSERT_EQ(Shell(bin_ + " --merge " + c + "/shard_1 " + c + "/shard_2 --no-plots --out " + c +
                   " > /dev/null 2>&1"),

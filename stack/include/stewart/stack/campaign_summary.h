@@ -17,6 +17,10 @@ struct CsvTable {
   double Number(std::size_t row, int column) const;
 };
 
+/// One CSV field: quoted (RFC 4180) when it holds a comma, a quote or a line
+/// break; a line break becomes a space so a row stays one line.
+std::string CsvField(const std::string& s);
+
 /// Reads a CSV written by the campaign (RFC 4180 quoting). Throws InputError
 /// naming the file and line when a row has the wrong number of fields.
 CsvTable ReadCsv(const std::string& path);

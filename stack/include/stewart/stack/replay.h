@@ -170,7 +170,7 @@ struct SafetyReplayResult {
   TimeStats replayed_ns;  ///< filter time of the replay, over the compared steps
   TimeStats recorded_ns;  ///< the live filter's (safety_diagnostics_t.compute_ns), same steps
   safety::FilterCaseCounts replayed_cases{};  ///< per FilterCase, over every replayed step
-  std::vector<SafetyStep> steps;         ///< in recorded nominal order
+  std::vector<SafetyStep> steps;              ///< in recorded nominal order
 };
 
 /// `config.safety` is the filter to replay (variant, k, ...); `reference` is
