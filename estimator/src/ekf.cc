@@ -1,6 +1,5 @@
 #include "stewart/estimator/ekf.h"
 
-#include <Eigen/Cholesky>
 #include <cmath>
 
 #include "stewart/estimator/measurement_models.h"
@@ -24,6 +23,31 @@ void AddWhiteAcceleration(int axis, double sigma, double dt_s, EkfMatrix* P) {
   (*P)(kEkfQd + axis, kEkfQ + axis) += v * 0.5 * dt2 * dt_s;
   (*P)(kEkfQd + axis, kEkfQd + axis) += v * dt2;
 }
+
+// S = L D L^T of a small symmetric positive definite matrix (only its lower
+// triangle is read). Compute is false unless every pivot is positive and
+// finite: S not positive definite, or NaN in it.
+template <int N>
+struct LdltSmall {
+  Eigen::Matrix<double, N, N> l;  // strictly lower triangle: L (unit diagonal)
+  Eigen::Matrix<double, N, 1> inv_d;
+  bool Compute(const Eigen::Matrix<double, N, N>& s) {
+    Eigen::Matrix<double, N, 1> d;
+    for (int j = 0; j < N; ++j) {
+      double djj = s(j, j);
+      for (int k = 0; k < j; ++k) djj -= l(j, k) * l(j, k) * d(k);
+      if (!(djj > 0.0 && djj < HUGE_VAL)) return false;
+      d(j) = djj;
+      inv_d(j) = 1.0 / djj;
+      for (int i = j + 1; i < N; ++i) {
+        double lij = s(i, j);
+        for (int k = 0; k < j; ++k) lij -= l(i, k) * l(j, k) * d(k);
+        l(i, j) = lij * inv_d(j);
+      }
+    }
+    return true;
+  }
+};
 
 }  // namespace
 
@@ -121,18 +145,9 @@ void Ekf::Predict(double dt_s, int64_t utime, uint32_t* events) {
       config_.process_model == EstimatorProcessModel::kDynamics && command_fresh;
   double sigma_lin = config_.process_accel_std_mps2;
   double sigma_ang = config_.process_angaccel_std_radps2;
-  // Transition of [q; qd] to first order in dt: [[I, dt I], [dt A, I + dt B]]
-  // with A = dqdd/dq, B = dqdd/dqd (zero for the constant-velocity model).
-  Eigen::Matrix<double, 12, 12> phi = Eigen::Matrix<double, 12, 12>::Identity();
-  phi.topRightCorner<6, 6>().diagonal().setConstant(dt_s);
   if (use_dynamics) {
-    Matrix6d A, B;
     DynamicsAccelerationJacobians(params_, actuators_.viscous_friction_nspm, q, qd, command_n_,
-                                  &qdd_, &A, &B);
-    phi.bottomLeftCorner<6, 6>() = dt_s * A;
-    phi.bottomRightCorner<6, 6>() += dt_s * B;
-    dqdd_dq_ = A;
-    dqdd_dqd_ = B;
+                                  &qdd_, &dqdd_dq_, &dqdd_dqd_);
     sigma_lin = config_.dynamics_accel_std_mps2;
     sigma_ang = config_.dynamics_angaccel_std_radps2;
   } else {
@@ -143,11 +158,51 @@ void Ekf::Predict(double dt_s, int64_t utime, uint32_t* events) {
   x_.segment<6>(kEkfQ) += dt_s * qd + 0.5 * dt_s * dt_s * qdd_;
   x_.segment<6>(kEkfQd) += dt_s * qdd_;
 
-  // P <- Phi P Phi^T; the gyro bias rows and columns are unchanged by Phi.
-  const Eigen::Matrix<double, 12, kEkfStateSize> top = phi * P_.topRows<12>();
-  P_.topRows<12>() = top;
-  const Eigen::Matrix<double, kEkfStateSize, 12> left = P_.leftCols<12>() * phi.transpose();
-  P_.leftCols<12>() = left;
+  // P <- Phi P Phi^T with the transition of [q; qd] to first order in dt,
+  //   Phi = [[I, dt I], [0, I]] + [[0, 0], [W]],  W = dt [A, B]
+  // (A = dqdd/dq, B = dqdd/dqd; W = 0 for the constant-velocity model), and
+  // the identity on the gyro bias. Block by block, with X = P_[q,qd] (12x12,
+  // symmetric), Y = P_[b_g, (q,qd)] and U = W X:
+  //   X'_qq = X_qq + dt (X_vq + X_vq^T) + dt^2 X_vv
+  //   X'_vq = X_vq + U_q + dt (X_vv + U_v)
+  //   X'_vv = X_vv + U_v + U_v^T + U W^T
+  //   Y'_q = Y_q + dt Y_v,  Y'_v = Y_v + Y W^T.
+  // Only the lower blocks are computed; the upper ones are their transposes.
+  const Matrix6d x_qq = P_.block<6, 6>(kEkfQ, kEkfQ);
+  const Matrix6d x_vq = P_.block<6, 6>(kEkfQd, kEkfQ);
+  const Matrix6d x_vv = P_.block<6, 6>(kEkfQd, kEkfQd);
+  const Eigen::Matrix<double, 3, 6> y_q = P_.block<3, 6>(kEkfGyroBias, kEkfQ);
+  const Eigen::Matrix<double, 3, 6> y_v = P_.block<3, 6>(kEkfGyroBias, kEkfQd);
+  const Matrix6d x_vq_t = x_vq.transpose();
+  Matrix6d new_qq = x_qq + dt_s * (x_vq + x_vq_t) + (dt_s * dt_s) * x_vv;
+  Matrix6d new_vq = x_vq + dt_s * x_vv;
+  Matrix6d new_vv = x_vv;
+  Eigen::Matrix<double, 3, 6> new_yv = y_v;
+  if (use_dynamics) {
+    const Matrix6d wq = dt_s * dqdd_dq_, wv = dt_s * dqdd_dqd_;
+    // U = W X, by blocks: U_q = Wq X_qq + Wv X_vq, U_v = Wq X_qv + Wv X_vv.
+    Matrix6d u_q, u_v;
+    u_q.noalias() = wq.lazyProduct(x_qq);
+    u_q.noalias() += wv.lazyProduct(x_vq);
+    u_v.noalias() = wq.lazyProduct(x_vq_t);
+    u_v.noalias() += wv.lazyProduct(x_vv);
+    new_vq += u_q + dt_s * u_v;
+    Matrix6d uwt;
+    uwt.noalias() = u_q.lazyProduct(wq.transpose());
+    uwt.noalias() += u_v.lazyProduct(wv.transpose());
+    new_vv += u_v + u_v.transpose() + 0.5 * (uwt + uwt.transpose());
+    new_yv.noalias() += y_q.lazyProduct(wq.transpose());
+    new_yv.noalias() += y_v.lazyProduct(wv.transpose());
+  }
+  P_.block<6, 6>(kEkfQ, kEkfQ) = new_qq;
+  P_.block<6, 6>(kEkfQd, kEkfQ) = new_vq;
+  P_.block<6, 6>(kEkfQ, kEkfQd) = new_vq.transpose();
+  P_.block<6, 6>(kEkfQd, kEkfQd) = new_vv;
+  const Eigen::Matrix<double, 3, 6> new_yq = y_q + dt_s * y_v;
+  P_.block<3, 6>(kEkfGyroBias, kEkfQ) = new_yq;
+  P_.block<3, 6>(kEkfGyroBias, kEkfQd) = new_yv;
+  P_.block<6, 3>(kEkfQ, kEkfGyroBias) = new_yq.transpose();
+  P_.block<6, 3>(kEkfQd, kEkfGyroBias) = new_yv.transpose();
   for (int i = 0; i < 3; ++i) {
     AddWhiteAcceleration(i, sigma_lin, dt_s, &P_);
     AddWhiteAcceleration(i + 3, sigma_ang, dt_s, &P_);
@@ -156,31 +211,57 @@ void Ekf::Predict(double dt_s, int64_t utime, uint32_t* events) {
   P_.diagonal().segment<3>(kEkfGyroBias).array() += walk * walk * dt_s;
 }
 
-template <int M>
-bool Ekf::Correct(const Eigen::Matrix<double, M, 1>& y,
-                  const Eigen::Matrix<double, M, kEkfStateSize>& H,
-                  const Eigen::Matrix<double, M, M>& R, double* nis) {
-  using MatM = Eigen::Matrix<double, M, M>;
-  using MatNM = Eigen::Matrix<double, kEkfStateSize, M>;
-  const MatNM PHt = P_ * H.transpose();
-  const MatM S = H * PHt + R;
-  const Eigen::LLT<MatM> llt(S);
-  if (llt.info() != Eigen::Success) return false;
-  *nis = y.dot(llt.solve(y));
+template <int M, int NB>
+bool Ekf::Correct(const Eigen::Matrix<double, M, 1>& y, const std::array<int, NB>& blocks,
+                  const Eigen::Matrix<double, M, 3 * NB>& h, const Eigen::Matrix<double, M, M>& R,
+                  double* nis) {
+  // P H^T and S = H P H^T + R from the non-zero blocks of H only.
+  Eigen::Matrix<double, kEkfStateSize, M> pht;
+  pht.noalias() =
+      P_.template middleCols<3>(blocks[0]).lazyProduct(h.template leftCols<3>().transpose());
+  for (int b = 1; b < NB; ++b) {
+    pht.noalias() += P_.template middleCols<3>(blocks[b]).lazyProduct(
+        h.template middleCols<3>(3 * b).transpose());
+  }
+  Eigen::Matrix<double, M, M> S = R;
+  for (int b = 0; b < NB; ++b) {
+    S.noalias() +=
+        h.template middleCols<3>(3 * b).lazyProduct(pht.template middleRows<3>(blocks[b]));
+  }
+  // S = L D L^T. With Z = L^-1 (P H^T)^T and w = L^-1 y (one forward
+  // substitution each), K y = Z^T D^-1 w, K S K^T = Z^T D^-1 Z and
+  // y^T S^-1 y = w^T D^-1 w.
+  LdltSmall<M> ldlt;
+  if (!ldlt.Compute(S)) return false;
+  Eigen::Matrix<double, M, 1> w = y;
+  for (int k = 0; k < M; ++k) {
+    for (int i = k + 1; i < M; ++i) {
+      w(i) -= ldlt.l(i, k) * w(k);
+      pht.col(i) -= ldlt.l(i, k) * pht.col(k);
+    }
+  }
+  const Eigen::Matrix<double, M, 1> w_scaled = w.cwiseProduct(ldlt.inv_d);
+  *nis = w.dot(w_scaled);
   if (!(*nis <= config_.gating_chi2)) return false;  // also rejects NaN
-  const MatNM K = llt.solve(PHt.transpose()).transpose();
-  x_ += K * y;
-  P_ -= K * PHt.transpose();
-  P_ = 0.5 * (P_ + P_.transpose()).eval();
+  x_.noalias() += pht * w_scaled;
+  const Eigen::Matrix<double, kEkfStateSize, M> scaled = pht * ldlt.inv_d.asDiagonal();
+  P_.noalias() -= pht.lazyProduct(scaled.transpose());
+  for (int j = 0; j < kEkfStateSize; ++j) {  // symmetric to the last bit
+    for (int i = j + 1; i < kEkfStateSize; ++i) {
+      const double v = 0.5 * (P_(i, j) + P_(j, i));
+      P_(i, j) = v;
+      P_(j, i) = v;
+    }
+  }
   return true;
 }
 
 void Ekf::CorrectLegs(const Vector6d& leg_length_m, uint32_t* events) {
   Vector6d predicted;
-  MeasurementJacobian<6> H;
-  PredictLegLengths(params_, x_, &predicted, &H);
+  Matrix6d J;
+  PredictLegLengths(params_, Vector6d(x_.segment<6>(kEkfQ)), &predicted, &J);
   const Matrix6d R = Matrix6d::Identity() * leg_variance_m2_;
-  if (Correct<6>(leg_length_m - predicted, H, R, &last_leg_nis_)) {
+  if (Correct<6, 2>(leg_length_m - predicted, {kEkfQ, kEkfQ + 3}, J, R, &last_leg_nis_)) {
     consecutive_leg_rejections_ = 0;
   } else {
     *events |= kGateLegs;
@@ -190,18 +271,23 @@ void Ekf::CorrectLegs(const Vector6d& leg_length_m, uint32_t* events) {
 
 void Ekf::CorrectGyro(const Vector3d& gyro_radps, uint32_t* events) {
   Vector3d predicted;
-  MeasurementJacobian<3> H;
-  PredictGyro(x_, &predicted, &H);
+  Eigen::Matrix<double, 3, 9> h;
+  Matrix3d d_angles, d_rates;
+  PredictGyro(Vector6d(x_.segment<6>(kEkfQ)), Vector6d(x_.segment<6>(kEkfQd)),
+              x_.segment<3>(kEkfGyroBias), &predicted, &d_angles, &d_rates);
+  h << d_angles, d_rates, Matrix3d::Identity();
   double nis = 0.0;
-  if (!Correct<3>(gyro_radps - predicted, H, Matrix3d::Identity() * gyro_variance_, &nis)) {
+  if (!Correct<3, 3>(gyro_radps - predicted, {kEkfQ + 3, kEkfQd + 3, kEkfGyroBias}, h,
+                     Matrix3d::Identity() * gyro_variance_, &nis)) {
     *events |= kGateGyro;
   }
 }
 
 void Ekf::CorrectAccel(const Vector3d& accel_mps2, uint32_t* events) {
   Vector3d predicted;
-  MeasurementJacobian<3> H;
-  PredictAccel(x_, qdd_, imu_offset_m_, params_.gravity_mps2, &predicted, &H);
+  AccelJacobians j;
+  PredictAccel(Vector6d(x_.segment<6>(kEkfQ)), Vector6d(x_.segment<6>(kEkfQd)), qdd_, imu_offset_m_,
+               params_.gravity_mps2, &predicted, &j);
   // The predicted qdd is uncertain by the process model's acceleration noise.
   const double sigma =
       qdd_from_dynamics_ ? config_.dynamics_accel_std_mps2 : config_.process_accel_std_mps2;
@@ -213,22 +299,25 @@ void Ekf::CorrectAccel(const Vector3d& accel_mps2, uint32_t* events) {
     // it the innovation covariance ignores the velocity's uncertainty and
     // right after an initialisation good samples are gated.
     Eigen::Matrix<double, 3, 12> d_state;
-    const Eigen::Matrix<double, 3, 6> d =
-        AccelQddJacobian(x_, qdd_, imu_offset_m_, params_.gravity_mps2);
-    d_state << d * dqdd_dq_, d * dqdd_dqd_;
-    R += d_state * P_.topLeftCorner<12, 12>() * d_state.transpose();
+    d_state.leftCols<6>().noalias() = j.d_qdd * dqdd_dq_;
+    d_state.rightCols<6>().noalias() = j.d_qdd * dqdd_dqd_;
+    const Eigen::Matrix<double, 3, 12> dp = d_state.lazyProduct(P_.topLeftCorner<12, 12>());
+    R.noalias() += dp.lazyProduct(d_state.transpose());
   }
+  Eigen::Matrix<double, 3, 6> h;
+  h << j.d_angles, j.d_rates;
   double nis = 0.0;
-  if (!Correct<3>(accel_mps2 - predicted, H, R, &nis)) *events |= kGateAccel;
+  if (!Correct<3, 2>(accel_mps2 - predicted, {kEkfQ + 3, kEkfQd + 3}, h, R, &nis)) {
+    *events |= kGateAccel;
+  }
 }
 
 void Ekf::CorrectOrientation(const Vector3d& rpy_rad, uint32_t* events) {
-  MeasurementJacobian<3> H = MeasurementJacobian<3>::Zero();
-  H.block<3, 3>(0, kEkfQ + 3).setIdentity();
   Vector3d y = rpy_rad - x_.segment<3>(kEkfQ + 3);
   for (int i = 0; i < 3; ++i) y(i) = WrapAngle(y(i));
   double nis = 0.0;
-  if (!Correct<3>(y, H, Matrix3d::Identity() * orientation_variance_, &nis)) {
+  if (!Correct<3, 1>(y, {kEkfQ + 3}, Matrix3d::Identity(),
+                     Matrix3d::Identity() * orientation_variance_, &nis)) {
     *events |= kGateOrientation;
   }
 }

@@ -3,6 +3,8 @@
 // platform state [q, qd] plus the gyro bias. docs/estimator.md describes the
 // model, the tuning and the measured accuracy. No LCM, no heap allocation
 // per update, and time only from the samples' utime.
+#include <array>
+
 #include "stewart/estimator/ekf_types.h"
 #include "stewart/estimator/estimator_config.h"
 #include "stewart/model/actuator_params.h"
@@ -45,12 +47,14 @@ class Ekf {
   void CorrectGyro(const Vector3d& gyro_radps, uint32_t* events);
   void CorrectAccel(const Vector3d& accel_mps2, uint32_t* events);
   void CorrectOrientation(const Vector3d& rpy_rad, uint32_t* events);
-  /// Kalman correction with innovation `y`; false (and no change) when the
+  /// Kalman correction with innovation `y` for a measurement whose Jacobian
+  /// is non-zero only in the 3-column state blocks starting at `blocks`
+  /// (`h` holds those blocks side by side); false (and no change) when the
   /// innovation fails the gate.
-  template <int M>
-  bool Correct(const Eigen::Matrix<double, M, 1>& y,
-               const Eigen::Matrix<double, M, kEkfStateSize>& H,
-               const Eigen::Matrix<double, M, M>& R, double* nis);
+  template <int M, int NB>
+  bool Correct(const Eigen::Matrix<double, M, 1>& y, const std::array<int, NB>& blocks,
+               const Eigen::Matrix<double, M, 3 * NB>& h, const Eigen::Matrix<double, M, M>& R,
+               double* nis);
   bool LegsUsable(const SensorSample& sample, uint32_t* events) const;
 
   PlatformParams params_;
