@@ -49,6 +49,16 @@ struct LdltSmall {
   }
 };
 
+// P -= G G^T, column by column, each entry summed over G's columns in order.
+template <int M>
+void SubtractGram(const Eigen::Matrix<double, kEkfStateSize, M>& g, EkfMatrix* p) {
+  for (int j = 0; j < kEkfStateSize; ++j) {
+    EkfVector col = p->col(j);
+    for (int k = 0; k < M; ++k) col -= g(j, k) * g.col(k);
+    p->col(j) = col;
+  }
+}
+
 }  // namespace
 
 Ekf::Ekf(const PlatformParams& params, const ActuatorConfig& actuators, const SensorConfig& sensors,
@@ -190,7 +200,7 @@ void Ekf::Predict(double dt_s, int64_t utime, uint32_t* events) {
     Matrix6d uwt;
     uwt.noalias() = u_q.lazyProduct(wq.transpose());
     uwt.noalias() += u_v.lazyProduct(wv.transpose());
-    new_vv += u_v + u_v.transpose() + 0.5 * (uwt + uwt.transpose());
+    new_vv += (u_v + u_v.transpose()) + 0.5 * (uwt + uwt.transpose());
     new_yv.noalias() += y_q.lazyProduct(wq.transpose());
     new_yv.noalias() += y_v.lazyProduct(wv.transpose());
   }
@@ -244,15 +254,10 @@ bool Ekf::Correct(const Eigen::Matrix<double, M, 1>& y, const std::array<int, NB
   *nis = w.dot(w_scaled);
   if (!(*nis <= config_.gating_chi2)) return false;  // also rejects NaN
   x_.noalias() += pht * w_scaled;
-  const Eigen::Matrix<double, kEkfStateSize, M> scaled = pht * ldlt.inv_d.asDiagonal();
-  P_.noalias() -= pht.lazyProduct(scaled.transpose());
-  for (int j = 0; j < kEkfStateSize; ++j) {  // symmetric to the last bit
-    for (int i = j + 1; i < kEkfStateSize; ++i) {
-      const double v = 0.5 * (P_(i, j) + P_(j, i));
-      P_(i, j) = v;
-      P_(j, i) = v;
-    }
-  }
+  // P -= G G^T with G = Z^T D^-1/2: every entry is the same sum of the same
+  // products as its mirror, so P stays symmetric to the last bit.
+  for (int k = 0; k < M; ++k) pht.col(k) *= std::sqrt(ldlt.inv_d(k));
+  SubtractGram(pht, &P_);
   return true;
 }
 
