@@ -15,7 +15,8 @@ constexpr double kMaxPositionStdM = 0.05;
 
 // Discrete white-noise acceleration (one sample of constant acceleration with
 // std sigma) on the (q_i, qd_i) pair of axis i.
-void AddWhiteAcceleration(int axis, double sigma, double dt_s, EkfMatrix* P) {
+template <typename Matrix>
+void AddWhiteAcceleration(int axis, double sigma, double dt_s, Matrix* P) {
   const double v = sigma * sigma;
   const double dt2 = dt_s * dt_s;
   (*P)(kEkfQ + axis, kEkfQ + axis) += v * 0.25 * dt2 * dt2;
@@ -49,11 +50,42 @@ struct LdltSmall {
   }
 };
 
-// P -= G G^T, column by column, each entry summed over G's columns in order.
+// Whether every entry is finite: x - x is 0 for a finite x and NaN otherwise,
+// and a sum with a NaN in it is NaN (one vectorised pass, no branch per entry).
+template <typename Derived>
+bool AllFinite(const Eigen::MatrixBase<Derived>& m) {
+  return (m.array() - m.array()).sum() == 0.0;
+}
+
+// sin and cos of `to` = from + delta from those of `from`, by the angle-sum
+// formulas with sin and cos of delta from their Taylor series (exact to the
+// last bit for |delta| <= 0.01: the first omitted terms are delta^9/9! and
+// delta^10/10!); a direct evaluation for larger steps.
+EulerAngleTrig ShiftEulerAngleTrig(const EulerAngleTrig& from, const Vector3d& delta,
+                                   const Vector3d& to) {
+  if (!(delta.cwiseAbs().maxCoeff() <= 0.01)) return EulerAngleTrig(to);
+  const auto shift = [](double d, double* s, double* c) {
+    const double d2 = d * d;
+    const double sd = d * (1.0 - d2 / 6.0 * (1.0 - d2 / 20.0 * (1.0 - d2 / 42.0)));
+    const double cd = 1.0 - d2 / 2.0 * (1.0 - d2 / 12.0 * (1.0 - d2 / 30.0 * (1.0 - d2 / 56.0)));
+    const double s0 = *s, c0 = *c;
+    *s = s0 * cd + c0 * sd;
+    *c = c0 * cd - s0 * sd;
+  };
+  EulerAngleTrig t = from;
+  shift(delta.x(), &t.sin_phi, &t.cos_phi);
+  shift(delta.y(), &t.sin_theta, &t.cos_theta);
+  shift(delta.z(), &t.sin_psi, &t.cos_psi);
+  return t;
+}
+
+// P -= G G^T, column by column: an entry and its mirror are the same sum of
+// the same products (in the same order), so P stays symmetric to the last bit.
 template <int M>
-void SubtractGram(const Eigen::Matrix<double, kEkfStateSize, M>& g, EkfMatrix* p) {
+void SubtractGram(const Eigen::Matrix<double, kEkfStateSize + 1, M>& g,
+                  Eigen::Matrix<double, kEkfStateSize + 1, kEkfStateSize + 1>* p) {
   for (int j = 0; j < kEkfStateSize; ++j) {
-    EkfVector col = p->col(j);
+    Eigen::Matrix<double, kEkfStateSize + 1, 1> col = p->col(j);
     for (int k = 0; k < M; ++k) col -= g(j, k) * g.col(k);
     p->col(j) = col;
   }
@@ -91,7 +123,7 @@ void Ekf::SetForceCommand(int64_t utime, const Vector6d& force_n) {
 void Ekf::Reset() {
   initialized_ = false;
   x_.setZero();
-  P_.setIdentity();
+  P_ = PaddedIdentity();
   qdd_.setZero();
   consecutive_leg_rejections_ = 0;
   samples_since_init_ = 0;
@@ -101,7 +133,8 @@ void Ekf::Initialize(int64_t utime, const Vector6d& q, const Vector6d& qd, const
   x_.segment<6>(kEkfQ) = q;
   x_.segment<6>(kEkfQd) = qd;
   x_.segment<3>(kEkfGyroBias).setZero();
-  P_ = std.cwiseProduct(std).asDiagonal();
+  P_.setZero();
+  P_.diagonal().head<kEkfStateSize>() = std.cwiseProduct(std);
   qdd_.setZero();
   last_utime_ = utime;
   initialized_ = true;
@@ -145,7 +178,7 @@ bool Ekf::InitializeFromLegs(const SensorSample& sample, uint32_t* events) {
   return true;
 }
 
-void Ekf::Predict(double dt_s, int64_t utime, uint32_t* events) {
+void Ekf::Predict(double dt_s, int64_t utime, const EulerAngleTrig& trig, uint32_t* events) {
   const Vector6d q = x_.segment<6>(kEkfQ);
   const Vector6d qd = x_.segment<6>(kEkfQd);
   const bool command_fresh =
@@ -156,8 +189,8 @@ void Ekf::Predict(double dt_s, int64_t utime, uint32_t* events) {
   double sigma_lin = config_.process_accel_std_mps2;
   double sigma_ang = config_.process_angaccel_std_radps2;
   if (use_dynamics) {
-    DynamicsAccelerationJacobians(params_, actuators_.viscous_friction_nspm, q, qd, command_n_,
-                                  &qdd_, &dqdd_dq_, &dqdd_dqd_);
+    DynamicsAccelerationJacobians(params_, actuators_.viscous_friction_nspm, q, trig, qd,
+                                  command_n_, &qdd_, &dqdd_dq_, &dqdd_dqd_);
     sigma_lin = config_.dynamics_accel_std_mps2;
     sigma_ang = config_.dynamics_angaccel_std_radps2;
   } else {
@@ -226,7 +259,7 @@ bool Ekf::Correct(const Eigen::Matrix<double, M, 1>& y, const std::array<int, NB
                   const Eigen::Matrix<double, M, 3 * NB>& h, const Eigen::Matrix<double, M, M>& R,
                   double* nis) {
   // P H^T and S = H P H^T + R from the non-zero blocks of H only.
-  Eigen::Matrix<double, kEkfStateSize, M> pht;
+  Eigen::Matrix<double, kEkfStateSize + 1, M> pht;  // last row: zero
   pht.noalias() =
       P_.template middleCols<3>(blocks[0]).lazyProduct(h.template leftCols<3>().transpose());
   for (int b = 1; b < NB; ++b) {
@@ -253,18 +286,17 @@ bool Ekf::Correct(const Eigen::Matrix<double, M, 1>& y, const std::array<int, NB
   const Eigen::Matrix<double, M, 1> w_scaled = w.cwiseProduct(ldlt.inv_d);
   *nis = w.dot(w_scaled);
   if (!(*nis <= config_.gating_chi2)) return false;  // also rejects NaN
-  x_.noalias() += pht * w_scaled;
-  // P -= G G^T with G = Z^T D^-1/2: every entry is the same sum of the same
-  // products as its mirror, so P stays symmetric to the last bit.
+  x_.noalias() += pht.template topRows<kEkfStateSize>() * w_scaled;
+  // P -= G G^T with G = Z^T D^-1/2 (symmetric to the last bit).
   for (int k = 0; k < M; ++k) pht.col(k) *= std::sqrt(ldlt.inv_d(k));
   SubtractGram(pht, &P_);
   return true;
 }
 
-void Ekf::CorrectLegs(const Vector6d& leg_length_m, uint32_t* events) {
+void Ekf::CorrectLegs(const Vector6d& leg_length_m, const EulerAngleTrig& trig, uint32_t* events) {
   Vector6d predicted;
   Matrix6d J;
-  PredictLegLengths(params_, Vector6d(x_.segment<6>(kEkfQ)), &predicted, &J);
+  PredictLegLengths(params_, Vector6d(x_.segment<6>(kEkfQ)), trig, &predicted, &J);
   const Matrix6d R = Matrix6d::Identity() * leg_variance_m2_;
   if (Correct<6, 2>(leg_length_m - predicted, {kEkfQ, kEkfQ + 3}, J, R, &last_leg_nis_)) {
     consecutive_leg_rejections_ = 0;
@@ -274,12 +306,12 @@ void Ekf::CorrectLegs(const Vector6d& leg_length_m, uint32_t* events) {
   }
 }
 
-void Ekf::CorrectGyro(const Vector3d& gyro_radps, uint32_t* events) {
+void Ekf::CorrectGyro(const Vector3d& gyro_radps, const EulerAngleTrig& trig, uint32_t* events) {
   Vector3d predicted;
   Eigen::Matrix<double, 3, 9> h;
   Matrix3d d_angles, d_rates;
-  PredictGyro(Vector6d(x_.segment<6>(kEkfQ)), Vector6d(x_.segment<6>(kEkfQd)),
-              x_.segment<3>(kEkfGyroBias), &predicted, &d_angles, &d_rates);
+  PredictGyro(trig, Vector6d(x_.segment<6>(kEkfQd)), x_.segment<3>(kEkfGyroBias), &predicted,
+              &d_angles, &d_rates);
   h << d_angles, d_rates, Matrix3d::Identity();
   double nis = 0.0;
   if (!Correct<3, 3>(gyro_radps - predicted, {kEkfQ + 3, kEkfQd + 3, kEkfGyroBias}, h,
@@ -288,11 +320,11 @@ void Ekf::CorrectGyro(const Vector3d& gyro_radps, uint32_t* events) {
   }
 }
 
-void Ekf::CorrectAccel(const Vector3d& accel_mps2, uint32_t* events) {
+void Ekf::CorrectAccel(const Vector3d& accel_mps2, const EulerAngleTrig& trig, uint32_t* events) {
   Vector3d predicted;
   AccelJacobians j;
-  PredictAccel(Vector6d(x_.segment<6>(kEkfQ)), Vector6d(x_.segment<6>(kEkfQd)), qdd_, imu_offset_m_,
-               params_.gravity_mps2, &predicted, &j);
+  PredictAccel(trig, Vector6d(x_.segment<6>(kEkfQd)), qdd_, imu_offset_m_, params_.gravity_mps2,
+               &predicted, &j);
   // The predicted qdd is uncertain by the process model's acceleration noise.
   const double sigma =
       qdd_from_dynamics_ ? config_.dynamics_accel_std_mps2 : config_.process_accel_std_mps2;
@@ -303,11 +335,13 @@ void Ekf::CorrectAccel(const Vector3d& accel_mps2, uint32_t* events) {
     // accelerometer does not correct the pose through the dynamics; without
     // it the innovation covariance ignores the velocity's uncertainty and
     // right after an initialisation good samples are gated.
-    Eigen::Matrix<double, 3, 12> d_state;
-    d_state.leftCols<6>().noalias() = j.d_qdd * dqdd_dq_;
-    d_state.rightCols<6>().noalias() = j.d_qdd * dqdd_dqd_;
-    const Eigen::Matrix<double, 3, 12> dp = d_state.lazyProduct(P_.topLeftCorner<12, 12>());
-    R.noalias() += dp.lazyProduct(d_state.transpose());
+    // With T = (d_qdd [A B])^T (12x3): R += T^T P_[q,qd] T.
+    const Eigen::Matrix<double, 6, 3> d_t = j.d_qdd.transpose();
+    Eigen::Matrix<double, 12, 3> t;
+    t.topRows<6>().noalias() = dqdd_dq_.transpose() * d_t;
+    t.bottomRows<6>().noalias() = dqdd_dqd_.transpose() * d_t;
+    const Eigen::Matrix<double, 12, 3> pt = P_.topLeftCorner<12, 12>().lazyProduct(t);
+    R.noalias() += t.transpose() * pt;
   }
   Eigen::Matrix<double, 3, 6> h;
   h << j.d_angles, j.d_rates;
@@ -351,20 +385,34 @@ UpdateResult Ekf::Update(const SensorSample& sample) {
     result.has_estimate = true;
     return result;
   }
-  Predict(dt_s, sample.utime, &events);
+  // One sincos per angle per update: the corrections move the angles by
+  // little, so their sines and cosines follow by the angle-sum formulas.
+  Vector3d angles = x_.segment<3>(kEkfQ + 3);
+  EulerAngleTrig trig(angles);
+  const auto follow_angles = [&]() {
+    const Vector3d now = x_.segment<3>(kEkfQ + 3);
+    trig = ShiftEulerAngleTrig(trig, now - angles, now);
+    angles = now;
+  };
+  Predict(dt_s, sample.utime, trig, &events);
   last_utime_ = sample.utime;
-  if (legs_ok) CorrectLegs(sample.leg_length_m, &events);
+  if (legs_ok) {
+    follow_angles();
+    CorrectLegs(sample.leg_length_m, trig, &events);
+  }
   if (sample.imu_valid) {
     if (sample.gyro_radps.allFinite() &&
         sample.gyro_radps.cwiseAbs().maxCoeff() <= config_.max_gyro_radps) {
-      CorrectGyro(sample.gyro_radps, &events);
+      follow_angles();
+      CorrectGyro(sample.gyro_radps, trig, &events);
     } else {
       events |= kRejectGyroInvalid;
     }
     if (config_.use_accelerometer) {
       if (sample.accel_mps2.allFinite() &&
           sample.accel_mps2.cwiseAbs().maxCoeff() <= config_.max_accel_mps2) {
-        CorrectAccel(sample.accel_mps2, &events);
+        follow_angles();
+        CorrectAccel(sample.accel_mps2, trig, &events);
       } else {
         events |= kRejectAccelInvalid;
       }
@@ -382,7 +430,7 @@ UpdateResult Ekf::Update(const SensorSample& sample) {
   // Divergence: the legs keep disagreeing with the estimate, or the filter
   // arithmetic broke down. Either way restart from the legs.
   const bool broken =
-      !x_.allFinite() || !P_.allFinite() ||
+      !AllFinite(x_) || !AllFinite(P_) ||
       P_.diagonal().segment<3>(kEkfQ).maxCoeff() > kMaxPositionStdM * kMaxPositionStdM;
   if (broken || consecutive_leg_rejections_ >= config_.divergence_rejections) {
     events |= kEventDiverged;
@@ -395,6 +443,12 @@ UpdateResult Ekf::Update(const SensorSample& sample) {
   }
   result.has_estimate = true;
   return result;
+}
+
+Ekf::PaddedMatrix Ekf::PaddedIdentity() {
+  PaddedMatrix p = PaddedMatrix::Zero();
+  p.diagonal().head<kEkfStateSize>().setOnes();
+  return p;
 }
 
 Estimate Ekf::estimate() const {

@@ -54,9 +54,8 @@ struct BodyRateMatrix {
 
 }  // namespace
 
-void PredictLegLengths(const PlatformParams& params, const Vector6d& q, Vector6d* leg_length_m,
-                       Matrix6d* dlength_dq) {
-  const EulerAngleTrig trig(q.tail<3>());
+void PredictLegLengths(const PlatformParams& params, const Vector6d& q, const EulerAngleTrig& trig,
+                       Vector6d* leg_length_m, Matrix6d* dlength_dq) {
   const Matrix3d R = RotationFromEuler(trig);
   const Matrix3d E = EulerRateMatrix(trig);
   using LegVectors = Eigen::Array<double, 3, kNumLegs>;
@@ -78,15 +77,16 @@ void PredictLegLengths(const PlatformParams& params, const Vector6d& q, Vector6d
 void PredictLegLengths(const PlatformParams& params, const EkfVector& x, Vector6d* leg_length_m,
                        MeasurementJacobian<6>* jacobian) {
   Matrix6d j;
-  PredictLegLengths(params, Vector6d(x.segment<6>(kEkfQ)), leg_length_m, &j);
+  const Vector6d q = x.segment<6>(kEkfQ);
+  PredictLegLengths(params, q, EulerAngleTrig(q.tail<3>()), leg_length_m, &j);
   jacobian->setZero();
   jacobian->block<6, 6>(0, kEkfQ) = j;
 }
 
 // h = E_b(r) rd + b_g: d/drd = E_b, d/db_g = I, d/dr = [X_phi rd, X_theta rd, 0].
-void PredictGyro(const Vector6d& q, const Vector6d& qd, const Vector3d& bias, Vector3d* gyro_radps,
-                 Matrix3d* dgyro_dangles, Matrix3d* dgyro_drates) {
-  const BodyRateMatrix eb(EulerAngleTrig(q.tail<3>()));
+void PredictGyro(const EulerAngleTrig& trig, const Vector6d& qd, const Vector3d& bias,
+                 Vector3d* gyro_radps, Matrix3d* dgyro_dangles, Matrix3d* dgyro_drates) {
+  const BodyRateMatrix eb(trig);
   const Vector3d rd = qd.tail<3>();
   *gyro_radps = eb.Times(rd) + bias;
   dgyro_dangles->col(0) = eb.DPhiTimes(rd);
@@ -97,7 +97,7 @@ void PredictGyro(const Vector6d& q, const Vector6d& qd, const Vector3d& bias, Ve
 
 void PredictGyro(const EkfVector& x, Vector3d* gyro_radps, MeasurementJacobian<3>* jacobian) {
   Matrix3d d_angles, d_rates;
-  PredictGyro(Vector6d(x.segment<6>(kEkfQ)), Vector6d(x.segment<6>(kEkfQd)),
+  PredictGyro(EulerAngleTrig(x.segment<3>(kEkfQ + 3)), Vector6d(x.segment<6>(kEkfQd)),
               x.segment<3>(kEkfGyroBias), gyro_radps, &d_angles, &d_rates);
   jacobian->setZero();
   jacobian->block<3, 3>(0, kEkfQ + 3) = d_angles;
@@ -110,10 +110,9 @@ void PredictGyro(const EkfVector& x, Vector3d* gyro_radps, MeasurementJacobian<3
 //   omega = E_b rd,  alpha = E_b rdd + (X_phi phid + X_theta thetad) rd.
 // d(R^T v)/dr = [R^T v]x E_b; d(omega x (omega x r))/d omega =
 // (omega.r) I + omega r^T - 2 r omega^T; alpha x r = -[r]x alpha.
-void PredictAccel(const Vector6d& q, const Vector6d& qd, const Vector6d& qdd,
+void PredictAccel(const EulerAngleTrig& trig, const Vector6d& qd, const Vector6d& qdd,
                   const Vector3d& imu_offset_in_P_m, double gravity_mps2, Vector3d* accel_mps2,
                   AccelJacobians* jacobians) {
-  const EulerAngleTrig trig(q.tail<3>());
   const BodyRateMatrix eb(trig);
   const Matrix3d R = RotationFromEuler(trig);
   const Vector3d& r = imu_offset_in_P_m;
@@ -151,7 +150,7 @@ void PredictAccel(const Vector6d& q, const Vector6d& qd, const Vector6d& qdd,
 void PredictAccel(const EkfVector& x, const Vector6d& qdd, const Vector3d& imu_offset_in_P_m,
                   double gravity_mps2, Vector3d* accel_mps2, MeasurementJacobian<3>* jacobian) {
   AccelJacobians j;
-  PredictAccel(Vector6d(x.segment<6>(kEkfQ)), Vector6d(x.segment<6>(kEkfQd)), qdd,
+  PredictAccel(EulerAngleTrig(x.segment<3>(kEkfQ + 3)), Vector6d(x.segment<6>(kEkfQd)), qdd,
                imu_offset_in_P_m, gravity_mps2, accel_mps2, &j);
   jacobian->setZero();
   jacobian->block<3, 3>(0, kEkfQ + 3) = j.d_angles;
@@ -163,7 +162,7 @@ Eigen::Matrix<double, 3, 6> AccelQddJacobian(const EkfVector& x, const Vector6d&
                                              double gravity_mps2) {
   Vector3d unused;
   AccelJacobians j;
-  PredictAccel(Vector6d(x.segment<6>(kEkfQ)), Vector6d(x.segment<6>(kEkfQd)), qdd,
+  PredictAccel(EulerAngleTrig(x.segment<3>(kEkfQ + 3)), Vector6d(x.segment<6>(kEkfQd)), qdd,
                imu_offset_in_P_m, gravity_mps2, &unused, &j);
   return j.d_qdd;
 }

@@ -9,7 +9,7 @@ namespace {
 
 // The six legs side by side: row k holds component k of one vector per leg.
 using LegScalars = Eigen::Array<double, 1, kNumLegs>;
-using LegVectors = Eigen::Array<double, 3, kNumLegs>;
+using LegVectors = Eigen::Array<double, 3, kNumLegs, Eigen::RowMajor>;
 
 LegVectors Cross(const LegVectors& a, const LegVectors& b) {
   LegVectors c;
@@ -31,45 +31,6 @@ LegVectors CrossWith(const LegVectors& a, const Vector3d& b) {
 // sum_i a_i b_i^T (3x3).
 Matrix3d SumOfOuterProducts(const LegVectors& a, const LegVectors& b) {
   return a.matrix().lazyProduct(b.matrix().transpose());
-}
-
-// The first and second derivatives of the three elementary rotations of
-// R = Rz(psi) Ry(theta) Rx(phi).
-struct ElementaryRotations {
-  explicit ElementaryRotations(const EulerAngleTrig& t) {
-    const double cf = t.cos_phi, sf = t.sin_phi, ct = t.cos_theta, st = t.sin_theta;
-    const double cp = t.cos_psi, sp = t.sin_psi;
-    x[0] << 1, 0, 0, 0, cf, -sf, 0, sf, cf;
-    x[1] << 0, 0, 0, 0, -sf, -cf, 0, cf, -sf;
-    x[2] << 0, 0, 0, 0, -cf, sf, 0, -sf, -cf;
-    y[0] << ct, 0, st, 0, 1, 0, -st, 0, ct;
-    y[1] << -st, 0, ct, 0, 0, 0, -ct, 0, -st;
-    y[2] << -ct, 0, -st, 0, 0, 0, st, 0, -ct;
-    z[0] << cp, -sp, 0, sp, cp, 0, 0, 0, 1;
-    z[1] << -sp, -cp, 0, cp, -sp, 0, 0, 0, 0;
-    z[2] << -cp, sp, 0, -sp, -cp, 0, 0, 0, 0;
-  }
-  Matrix3d x[3], y[3], z[3];  // [k]: k-th derivative
-};
-
-// d^2/(dr_a dr_b) of sum_kl R_kl S_kl (r = [phi theta psi]): the second
-// derivative of w^T R p summed over the pairs (w, p) that make up
-// S = sum w p^T.
-Matrix3d RotationHessianContraction(const EulerAngleTrig& trig, const Matrix3d& S) {
-  const ElementaryRotations e(trig);
-  // <Z Y X, S> = <X, Y^T Z^T S>.
-  const auto inner = [](const Matrix3d& a, const Matrix3d& b) { return a.cwiseProduct(b).sum(); };
-  const Matrix3d z0 = e.z[0].transpose() * S;
-  const Matrix3d z1 = e.z[1].transpose() * S;
-  const Matrix3d z2 = e.z[2].transpose() * S;
-  Matrix3d h;
-  h(0, 0) = inner(e.x[2], e.y[0].transpose() * z0);
-  h(1, 1) = inner(e.x[0], e.y[2].transpose() * z0);
-  h(2, 2) = inner(e.x[0], e.y[0].transpose() * z2);
-  h(0, 1) = h(1, 0) = inner(e.x[1], e.y[1].transpose() * z0);
-  h(0, 2) = h(2, 0) = inner(e.x[1], e.y[0].transpose() * z1);
-  h(1, 2) = h(2, 1) = inner(e.x[0], e.y[1].transpose() * z1);
-  return h;
 }
 
 }  // namespace
@@ -95,13 +56,20 @@ Vector6d DynamicsAcceleration(const PlatformParams& params, double friction_nspm
 void DynamicsAccelerationJacobians(const PlatformParams& params, double friction_nspm,
                                    const Vector6d& q, const Vector6d& qd, const Vector6d& force_n,
                                    Vector6d* qdd, Matrix6d* dqdd_dq, Matrix6d* dqdd_dqd) {
+  DynamicsAccelerationJacobians(params, friction_nspm, q, EulerAngleTrig(q.tail<3>()), qd, force_n,
+                                qdd, dqdd_dq, dqdd_dqd);
+}
+
+void DynamicsAccelerationJacobians(const PlatformParams& params, double friction_nspm,
+                                   const Vector6d& q, const EulerAngleTrig& trig,
+                                   const Vector6d& qd, const Vector6d& force_n, Vector6d* qdd,
+                                   Matrix6d* dqdd_dq, Matrix6d* dqdd_dqd) {
   DynamicsTerms terms;
   EvaluateDynamics(params, q, qd, &terms);
   const Matrix6d& H = terms.H;
   const Vector6d leg_speed_mps = H.transpose() * qd;
   const Vector6d force = force_n - friction_nspm * leg_speed_mps;
 
-  const EulerAngleTrig trig(q.tail<3>());
   const Matrix3d R = RotationFromEuler(trig);
   const Matrix3d E = EulerRateMatrix(trig);
   const Vector3d omega = E * qd.tail<3>();
@@ -145,20 +113,36 @@ void DynamicsAccelerationJacobians(const PlatformParams& params, double friction
       SumOfOuterProducts(u.rowwise() * b, u) - SumOfOuterProducts(ap, p) + uk + uk.transpose();
   k_rr.diagonal().array() += (ap * p).sum();
 
-  // Second derivatives of R: dPhi/dl_i = (F + g k n_z / L) n - (g k / L + g m2) e_z
-  // at each R p_i, and -g m e_z at R c.
+  // Second derivatives of the points R x (x = p_i and the CoM) by the
+  // angles: d2(R x)/dr_a dr_b = E_b x (E_a x R x) + dE_b/dr_a x R x (E_a:
+  // column a of E). Weighted by the gradients dPhi/dl_i =
+  // (F + g k n_z / L) n - (g k / L + g m2) e_z at the legs and -g m e_z at the
+  // CoM, and summed, they give E^T (Q^T - tr(Q) I) E + [tau . dE_b/dr_a] with
+  // Q = sum x grad^T and tau = sum x cross grad.
   LegVectors grad = n.rowwise() * (f + gk * nz * inv_l);
   grad.row(2) -= gk * inv_l + g * leg.rod_mass_kg;
-  Matrix3d S = grad.matrix().lazyProduct(params.platform_joints_in_P_m.transpose());
-  S.row(2) -= g * params.platform_mass_kg * params.platform_com_in_P_m.transpose();
+  const Vector3d com = R * params.platform_com_in_P_m;
+  const double weight = g * params.platform_mass_kg;
+  Matrix3d q_t = SumOfOuterProducts(grad, p);  // Q^T
+  q_t.row(2) -= weight * com.transpose();
+  const Vector3d tau =
+      Cross(p, grad).matrix().rowwise().sum() - weight * Vector3d(com.y(), -com.x(), 0.0);
+  k_rr += q_t;
+  k_rr.diagonal().array() -= q_t.trace();
+  Matrix3d rr = E.transpose() * (k_rr * E);
+  {
+    const double ct = trig.cos_theta, st = trig.sin_theta, cp = trig.cos_psi, sp = trig.sin_psi;
+    rr(1, 0) -= tau.x() * cp * st + tau.y() * sp * st + tau.z() * ct;  // dE_0/dtheta
+    rr(2, 0) += ct * (tau.y() * cp - tau.x() * sp);                    // dE_0/dpsi
+    rr(2, 1) -= tau.x() * cp + tau.y() * sp;                           // dE_1/dpsi
+  }
 
   Matrix6d numerator;
   const Matrix3d c_tr_e = c_tr * E;
   numerator.topLeftCorner<3, 3>() = h_tt;
   numerator.topRightCorner<3, 3>() = -c_tr_e;
   numerator.bottomLeftCorner<3, 3>() = -c_tr_e.transpose();
-  numerator.bottomRightCorner<3, 3>() =
-      E.transpose() * (k_rr * E) + RotationHessianContraction(trig, S);
+  numerator.bottomRightCorner<3, 3>() = rr;
 
   // Friction: -c_v H d(ld)/dq.
   const LegVectors v = CrossWith(p, -omega).colwise() + qd.head<3>().array();  // omega x p + td
@@ -187,13 +171,12 @@ void DynamicsAccelerationJacobians(const PlatformParams& params, double friction
     dqdd_dqd->setConstant(NAN);
     return;
   }
-  Rhs6<13> rhs;
-  rhs.col(0) = H * force - terms.C_qd - terms.G;
-  rhs.middleCols<6>(1) = numerator;
+  *qdd = inertia.Solve<1>(H * force - terms.C_qd - terms.G);
+  Rhs6<12> rhs;
+  rhs.leftCols<6>() = numerator;
   rhs.rightCols<6>().noalias() = -friction_nspm * H.lazyProduct(H.transpose());
-  inertia.SolveInPlace<13>(&rhs);
-  *qdd = rhs.col(0);
-  *dqdd_dq = rhs.middleCols<6>(1);
+  inertia.SolveInPlace<12>(&rhs);
+  *dqdd_dq = rhs.leftCols<6>();
   *dqdd_dqd = rhs.rightCols<6>();
 }
 

@@ -6,6 +6,7 @@
 // whole row block, for tests and tools.
 #include "stewart/estimator/ekf_types.h"
 #include "stewart/model/platform_params.h"
+#include "stewart/model/rotation.h"
 
 namespace stewart {
 
@@ -14,15 +15,17 @@ using MeasurementJacobian = Eigen::Matrix<double, M, kEkfStateSize>;
 
 /// Leg lengths L(q) by inverse kinematics (paper eq. 1); dL/dq = J_l, so no
 /// forward-kinematics solve is needed in the update.
-void PredictLegLengths(const PlatformParams& params, const Vector6d& q, Vector6d* leg_length_m,
-                       Matrix6d* dlength_dq);
+/// Compact form: `trig` holds the sines and cosines of q's angles.
+void PredictLegLengths(const PlatformParams& params, const Vector6d& q, const EulerAngleTrig& trig,
+                       Vector6d* leg_length_m, Matrix6d* dlength_dq);
 void PredictLegLengths(const PlatformParams& params, const EkfVector& x, Vector6d* leg_length_m,
                        MeasurementJacobian<6>* jacobian);
 
-/// Gyro: omega_P = R^T E(r) rd + b_g (rad/s, {P}). Compact form: the blocks
-/// for the Euler angles and their rates (the bias block is the identity).
-void PredictGyro(const Vector6d& q, const Vector6d& qd, const Vector3d& bias, Vector3d* gyro_radps,
-                 Matrix3d* dgyro_dangles, Matrix3d* dgyro_drates);
+/// Gyro: omega_P = R^T E(r) rd + b_g (rad/s, {P}). Compact form (`trig` of
+/// the Euler angles): the blocks for the angles and their rates (the bias
+/// block is the identity).
+void PredictGyro(const EulerAngleTrig& trig, const Vector6d& qd, const Vector3d& bias,
+                 Vector3d* gyro_radps, Matrix3d* dgyro_dangles, Matrix3d* dgyro_drates);
 void PredictGyro(const EkfVector& x, Vector3d* gyro_radps, MeasurementJacobian<3>* jacobian);
 
 /// The non-zero blocks of the accelerometer's Jacobians.
@@ -35,8 +38,8 @@ struct AccelJacobians {
 /// Accelerometer: specific force at the IMU, {P} (m/s^2), given the
 /// predicted qdd. The state Jacobian holds qdd fixed (docs/estimator.md); with
 /// the dynamics process model the EKF adds d_qdd * dqdd/dx to the noise.
-/// `jacobians` may be null.
-void PredictAccel(const Vector6d& q, const Vector6d& qd, const Vector6d& qdd,
+/// Compact form: `trig` of the Euler angles; `jacobians` may be null.
+void PredictAccel(const EulerAngleTrig& trig, const Vector6d& qd, const Vector6d& qdd,
                   const Vector3d& imu_offset_in_P_m, double gravity_mps2, Vector3d* accel_mps2,
                   AccelJacobians* jacobians);
 void PredictAccel(const EkfVector& x, const Vector6d& qdd, const Vector3d& imu_offset_in_P_m,

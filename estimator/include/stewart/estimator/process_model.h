@@ -8,6 +8,7 @@
 // F in N (leg forces, clipped to the actuator limit by the caller), c_v in
 // N/(m/s), qdd in m/s^2 and rad/s^2 (Euler accelerations).
 #include "stewart/model/platform_params.h"
+#include "stewart/model/rotation.h"
 #include "stewart/model/types.h"
 
 namespace stewart {
@@ -22,5 +23,10 @@ Vector6d DynamicsAcceleration(const PlatformParams& params, double friction_nspm
 void DynamicsAccelerationJacobians(const PlatformParams& params, double friction_nspm,
                                    const Vector6d& q, const Vector6d& qd, const Vector6d& force_n,
                                    Vector6d* qdd, Matrix6d* dqdd_dq, Matrix6d* dqdd_dqd);
+/// The same, given the sines and cosines of q's angles.
+void DynamicsAccelerationJacobians(const PlatformParams& params, double friction_nspm,
+                                   const Vector6d& q, const EulerAngleTrig& trig,
+                                   const Vector6d& qd, const Vector6d& force_n, Vector6d* qdd,
+                                   Matrix6d* dqdd_dq, Matrix6d* dqdd_dqd);
 
 }  // namespace stewart
