@@ -81,16 +81,31 @@ EulerAngleTrig ShiftEulerAngleTrig(const EulerAngleTrig& from, const Vector3d& d
   return t;
 }
 
-// P -= G G^T, column by column: an entry and its mirror are the same sum of
-// the same products (in the same order), so P stays symmetric to the last bit.
+// P -= G G^T on the lower block triangle (blocks of rows and columns [0, 6),
+// [6, 12), [12, 16): whole SIMD packets), the upper blocks as the mirror.
+// Inside a diagonal block an entry and its mirror are the same sum of the
+// same products in the same order, so P stays symmetric to the last bit.
 template <int M>
 void SubtractGram(const Eigen::Matrix<double, kEkfStateSize + 1, M>& g,
                   Eigen::Matrix<double, kEkfStateSize + 1, kEkfStateSize + 1>* p) {
-  for (int j = 0; j < kEkfStateSize; ++j) {
-    Eigen::Matrix<double, kEkfStateSize + 1, 1> col = p->col(j);
+  constexpr int kN = kEkfStateSize + 1;
+  for (int j = 0; j < 6; ++j) {
+    Eigen::Matrix<double, kN, 1> col = p->col(j);
     for (int k = 0; k < M; ++k) col -= g(j, k) * g.col(k);
     p->col(j) = col;
   }
+  for (int j = 6; j < 12; ++j) {
+    Eigen::Matrix<double, kN - 6, 1> col = p->col(j).template tail<kN - 6>();
+    for (int k = 0; k < M; ++k) col -= g(j, k) * g.col(k).template tail<kN - 6>();
+    p->col(j).template tail<kN - 6>() = col;
+  }
+  for (int j = 12; j < kEkfStateSize; ++j) {
+    Eigen::Matrix<double, kN - 12, 1> col = p->col(j).template tail<kN - 12>();
+    for (int k = 0; k < M; ++k) col -= g(j, k) * g.col(k).template tail<kN - 12>();
+    p->col(j).template tail<kN - 12>() = col;
+  }
+  p->template block<6, 10>(0, 6) = p->template block<10, 6>(6, 0).transpose();
+  p->template block<6, 4>(6, 12) = p->template block<4, 6>(12, 6).transpose();
 }
 
 }  // namespace
