@@ -52,7 +52,13 @@ Vector6d DynamicsAcceleration(const PlatformParams& params, double friction_nspm
 //   a = F/L + g k n_z/L^2,  b = -F/L - 3 g k n_z/L^2,  c = g k/L^2.
 // The friction F = F_cmd - c_v ld (ld = H^T qd) adds -c_v H d(ld)/dq, with
 //   d(ld_i)/dq = [nd_i^T, (p_i x (nd_i + n_i x omega))^T E + u_i^T [dE/dr rd]],
-// nd = (v - n ld) / L, v = td + omega x p, u = p x n.
+// nd = (v - n ld) / L, v = td + omega x p, u = p x n. Then
+//   dqdd/dq = M^-1 (d2Phi/dq2 - c_v H d(ld)/dq)
+// without the inertial part -M^-1 d(M qdd + C qd)/dq, O(|qdd| + |qd|^2):
+// ~1e-4 of the rest at the scenario's speeds (docs/estimator.md).
+// dqdd/dqd = -M^-1 (c_v H H^T + d(C qd)/dqd); the Coriolis part is O(|qd|)
+// (C qd is quadratic in qd): ~m |qd| / L ~ 0.05 kg/s at the scenario's speeds
+// against c_v |H H^T| ~ 2 N s/m for the friction, so it is left out.
 void DynamicsAccelerationJacobians(const PlatformParams& params, double friction_nspm,
                                    const Vector6d& q, const Vector6d& qd, const Vector6d& force_n,
                                    Vector6d* qdd, Matrix6d* dqdd_dq, Matrix6d* dqdd_dqd) {
