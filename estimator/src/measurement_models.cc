@@ -58,7 +58,7 @@ void PredictLegLengths(const PlatformParams& params, const Vector6d& q, const Eu
                        Vector6d* leg_length_m, Matrix6d* dlength_dq) {
   const Matrix3d R = RotationFromEuler(trig);
   const Matrix3d E = EulerRateMatrix(trig);
-  using LegVectors = Eigen::Array<double, 3, kNumLegs>;
+  using LegVectors = Eigen::Array<double, 3, kNumLegs, Eigen::RowMajor>;
   using LegScalars = Eigen::Array<double, 1, kNumLegs>;
   const LegVectors p = R.lazyProduct(params.platform_joints_in_P_m).array();
   const LegVectors l = (p.colwise() + q.head<3>().array()) - params.base_joints_in_B_m.array();
