@@ -1,6 +1,5 @@
 #include "stewart/estimator/ekf.h"
 
-#include <Eigen/Cholesky>
 #include <cmath>
 
 #include "stewart/estimator/measurement_models.h"
@@ -16,13 +15,97 @@ constexpr double kMaxPositionStdM = 0.05;
 
 // Discrete white-noise acceleration (one sample of constant acceleration with
 // std sigma) on the (q_i, qd_i) pair of axis i.
-void AddWhiteAcceleration(int axis, double sigma, double dt_s, EkfMatrix* P) {
+template <typename Matrix>
+void AddWhiteAcceleration(int axis, double sigma, double dt_s, Matrix* P) {
   const double v = sigma * sigma;
   const double dt2 = dt_s * dt_s;
   (*P)(kEkfQ + axis, kEkfQ + axis) += v * 0.25 * dt2 * dt2;
   (*P)(kEkfQ + axis, kEkfQd + axis) += v * 0.5 * dt2 * dt_s;
   (*P)(kEkfQd + axis, kEkfQ + axis) += v * 0.5 * dt2 * dt_s;
   (*P)(kEkfQd + axis, kEkfQd + axis) += v * dt2;
+}
+
+// S = L D L^T of a small symmetric positive definite matrix (only its lower
+// triangle is read). Compute is false unless every pivot is positive and
+// finite: S not positive definite, or NaN in it.
+template <int N>
+struct LdltSmall {
+  Eigen::Matrix<double, N, N> l;  // strictly lower triangle: L (unit diagonal)
+  Eigen::Matrix<double, N, 1> inv_d;
+  bool Compute(const Eigen::Matrix<double, N, N>& s) {
+    Eigen::Matrix<double, N, 1> d;
+    for (int j = 0; j < N; ++j) {
+      double djj = s(j, j);
+      for (int k = 0; k < j; ++k) djj -= l(j, k) * l(j, k) * d(k);
+      if (!(djj > 0.0 && djj < HUGE_VAL)) return false;
+      d(j) = djj;
+      inv_d(j) = 1.0 / djj;
+      for (int i = j + 1; i < N; ++i) {
+        double lij = s(i, j);
+        for (int k = 0; k < j; ++k) lij -= l(i, k) * l(j, k) * d(k);
+        l(i, j) = lij * inv_d(j);
+      }
+    }
+    return true;
+  }
+};
+
+// Whether every entry is finite: x - x is 0 for a finite x and NaN otherwise,
+// and a sum with a NaN in it is NaN (one vectorised pass, no branch per entry).
+template <typename Derived>
+bool AllFinite(const Eigen::MatrixBase<Derived>& m) {
+  return (m.array() - m.array()).sum() == 0.0;
+}
+
+// sin and cos of `to` = from + delta from those of `from`, by the angle-sum
+// formulas with sin and cos of delta from their Taylor series (for
+// |delta| <= 0.01 the first omitted terms, delta^9/9! and delta^10/10!, are
+// below 1e-23; measured over 1e7 random steps, the results differ from
+// std::sin and std::cos by at most 4 ulp of max(|sin from|, |sin to|) and 2 ulp
+// of cos); a direct evaluation for larger steps.
+EulerAngleTrig ShiftEulerAngleTrig(const EulerAngleTrig& from, const Vector3d& delta,
+                                   const Vector3d& to) {
+  if (!(delta.cwiseAbs().maxCoeff() <= 0.01)) return EulerAngleTrig(to);
+  const auto shift = [](double d, double* s, double* c) {
+    const double d2 = d * d;
+    const double sd = d + d * d2 * (-1.0 / 6 + d2 * (1.0 / 120 + d2 * (-1.0 / 5040)));
+    const double cd = 1.0 + d2 * (-0.5 + d2 * (1.0 / 24 + d2 * (-1.0 / 720 + d2 * (1.0 / 40320))));
+    const double s0 = *s, c0 = *c;
+    *s = s0 * cd + c0 * sd;
+    *c = c0 * cd - s0 * sd;
+  };
+  EulerAngleTrig t = from;
+  shift(delta.x(), &t.sin_phi, &t.cos_phi);
+  shift(delta.y(), &t.sin_theta, &t.cos_theta);
+  shift(delta.z(), &t.sin_psi, &t.cos_psi);
+  return t;
+}
+
+// P -= G G^T on the lower block triangle (blocks of rows and columns [0, 6),
+// [6, 12), [12, 16): whole SIMD packets), the upper blocks as the mirror.
+// Inside a diagonal block an entry and its mirror are the same sum of the
+// same products in the same order, so P stays symmetric to the last bit.
+template <int M>
+void SubtractGram(const Eigen::Matrix<double, kEkfStateSize + 1, M>& g,
+                  Eigen::Matrix<double, kEkfStateSize + 1, kEkfStateSize + 1>* p) {
+  constexpr int kN = kEkfStateSize + 1;
+  for (int j = 0; j < 6; ++j) {
+    Eigen::Matrix<double, kN, 1> col = p->col(j);
+    for (int k = 0; k < M; ++k) col -= g(j, k) * g.col(k);
+    p->col(j) = col;
+  }
+  for (int j = 6; j < 12; ++j) {
+    Eigen::Matrix<double, kN - 6, 1> col = p->col(j).template tail<kN - 6>();
+    for (int k = 0; k < M; ++k) col -= g(j, k) * g.col(k).template tail<kN - 6>();
+    p->col(j).template tail<kN - 6>() = col;
+  }
+  for (int j = 12; j < kEkfStateSize; ++j) {
+    Eigen::Matrix<double, kN - 12, 1> col = p->col(j).template tail<kN - 12>();
+    for (int k = 0; k < M; ++k) col -= g(j, k) * g.col(k).template tail<kN - 12>();
+    p->col(j).template tail<kN - 12>() = col;
+  }
+  p->template block<6, 10>(0, 6) = p->template block<10, 6>(6, 0).transpose();
+  p->template block<6, 4>(6, 12) = p->template block<4, 6>(12, 6).transpose();
 }
 
 }  // namespace
@@ -57,7 +140,7 @@ void Ekf::SetForceCommand(int64_t utime, const Vector6d& force_n) {
 void Ekf::Reset() {
   initialized_ = false;
   x_.setZero();
-  P_.setIdentity();
+  P_ = PaddedIdentity();
   qdd_.setZero();
   consecutive_leg_rejections_ = 0;
   samples_since_init_ = 0;
@@ -67,7 +150,8 @@ void Ekf::Initialize(int64_t utime, const Vector6d& q, const Vector6d& qd, const
   x_.segment<6>(kEkfQ) = q;
   x_.segment<6>(kEkfQd) = qd;
   x_.segment<3>(kEkfGyroBias).setZero();
-  P_ = std.cwiseProduct(std).asDiagonal();
+  P_.setZero();
+  P_.diagonal().head<kEkfStateSize>() = std.cwiseProduct(std);
   qdd_.setZero();
   last_utime_ = utime;
   initialized_ = true;
@@ -111,7 +195,7 @@ bool Ekf::InitializeFromLegs(const SensorSample& sample, uint32_t* events) {
   return true;
 }
 
-void Ekf::Predict(double dt_s, int64_t utime, uint32_t* events) {
+void Ekf::Predict(double dt_s, int64_t utime, const EulerAngleTrig& trig, uint32_t* events) {
   const Vector6d q = x_.segment<6>(kEkfQ);
   const Vector6d qd = x_.segment<6>(kEkfQd);
   const bool command_fresh =
@@ -121,18 +205,9 @@ void Ekf::Predict(double dt_s, int64_t utime, uint32_t* events) {
       config_.process_model == EstimatorProcessModel::kDynamics && command_fresh;
   double sigma_lin = config_.process_accel_std_mps2;
   double sigma_ang = config_.process_angaccel_std_radps2;
-  // Transition of [q; qd] to first order in dt: [[I, dt I], [dt A, I + dt B]]
-  // with A = dqdd/dq, B = dqdd/dqd (zero for the constant-velocity model).
-  Eigen::Matrix<double, 12, 12> phi = Eigen::Matrix<double, 12, 12>::Identity();
-  phi.topRightCorner<6, 6>().diagonal().setConstant(dt_s);
   if (use_dynamics) {
-    Matrix6d A, B;
-    DynamicsAccelerationJacobians(params_, actuators_.viscous_friction_nspm, q, qd, command_n_,
-                                  &qdd_, &A, &B);
-    phi.bottomLeftCorner<6, 6>() = dt_s * A;
-    phi.bottomRightCorner<6, 6>() += dt_s * B;
-    dqdd_dq_ = A;
-    dqdd_dqd_ = B;
+    DynamicsAccelerationJacobians(params_, actuators_.viscous_friction_nspm, q, trig, qd,
+                                  command_n_, &qdd_, &dqdd_dq_, &dqdd_dqd_);
     sigma_lin = config_.dynamics_accel_std_mps2;
     sigma_ang = config_.dynamics_angaccel_std_radps2;
   } else {
@@ -143,11 +218,36 @@ void Ekf::Predict(double dt_s, int64_t utime, uint32_t* events) {
   x_.segment<6>(kEkfQ) += dt_s * qd + 0.5 * dt_s * dt_s * qdd_;
   x_.segment<6>(kEkfQd) += dt_s * qdd_;
 
-  // P <- Phi P Phi^T; the gyro bias rows and columns are unchanged by Phi.
-  const Eigen::Matrix<double, 12, kEkfStateSize> top = phi * P_.topRows<12>();
-  P_.topRows<12>() = top;
-  const Eigen::Matrix<double, kEkfStateSize, 12> left = P_.leftCols<12>() * phi.transpose();
-  P_.leftCols<12>() = left;
+  // P <- Phi P Phi^T with the transition of [q; qd] to first order in dt,
+  //   Phi = [[I, dt I], [0, I]] + [[0, 0], [W]],  W = dt [A, B]
+  // (A = dqdd/dq, B = dqdd/dqd; W = 0 for the constant-velocity model), and
+  // the identity on the gyro bias, in place: first T = Phi P (rows), then
+  // T Phi^T (columns). With U = W P_[(q,qd), :] (6x16):
+  //   T_q = P_q + dt P_v,  T_v = P_v + U            (rows)
+  //   P'_:q = T_:q + dt T_:v                         (columns)
+  //   P'_vv = T_vv + T_v,(q,qd) W^T,  P'_bv = P_bv + U_b^T
+  // and the upper blocks as the mirror of the lower ones.
+  const auto rows_v = P_.middleRows<6>(kEkfQd);
+  if (use_dynamics) {
+    Eigen::Matrix<double, 6, 12> w;
+    w << dt_s * dqdd_dq_, dt_s * dqdd_dqd_;
+    Eigen::Matrix<double, 6, kEkfStateSize + 1> u;
+    u.noalias() = w.lazyProduct(P_.topRows<12>());
+    P_.middleRows<6>(kEkfQ) += dt_s * rows_v;
+    P_.middleRows<6>(kEkfQd) += u;
+    Matrix6d z;
+    z.noalias() = P_.block<6, 12>(kEkfQd, 0).lazyProduct(w.transpose());
+    P_.leftCols<6>() += dt_s * P_.middleCols<6>(kEkfQd);
+    P_.block<6, 6>(kEkfQd, kEkfQd) += z;
+    P_.block<4, 6>(kEkfGyroBias, kEkfQd) += u.rightCols<4>().transpose();
+  } else {
+    P_.middleRows<6>(kEkfQ) += dt_s * rows_v;
+    P_.leftCols<6>() += dt_s * P_.middleCols<6>(kEkfQd);
+  }
+  // Upper triangle := lower triangle.
+  for (int j = 1; j < kEkfStateSize; ++j) {
+    for (int i = 0; i < j; ++i) P_(i, j) = P_(j, i);
+  }
   for (int i = 0; i < 3; ++i) {
     AddWhiteAcceleration(i, sigma_lin, dt_s, &P_);
     AddWhiteAcceleration(i + 3, sigma_ang, dt_s, &P_);
@@ -156,31 +256,51 @@ void Ekf::Predict(double dt_s, int64_t utime, uint32_t* events) {
   P_.diagonal().segment<3>(kEkfGyroBias).array() += walk * walk * dt_s;
 }
 
-template <int M>
-bool Ekf::Correct(const Eigen::Matrix<double, M, 1>& y,
-                  const Eigen::Matrix<double, M, kEkfStateSize>& H,
-                  const Eigen::Matrix<double, M, M>& R, double* nis) {
-  using MatM = Eigen::Matrix<double, M, M>;
-  using MatNM = Eigen::Matrix<double, kEkfStateSize, M>;
-  const MatNM PHt = P_ * H.transpose();
-  const MatM S = H * PHt + R;
-  const Eigen::LLT<MatM> llt(S);
-  if (llt.info() != Eigen::Success) return false;
-  *nis = y.dot(llt.solve(y));
+template <int M, int NB>
+bool Ekf::Correct(const Eigen::Matrix<double, M, 1>& y, const std::array<int, NB>& blocks,
+                  const Eigen::Matrix<double, M, 3 * NB>& h, const Eigen::Matrix<double, M, M>& R,
+                  double* nis) {
+  // P H^T and S = H P H^T + R from the non-zero blocks of H only.
+  Eigen::Matrix<double, kEkfStateSize + 1, M> pht;  // last row: zero
+  pht.noalias() =
+      P_.template middleCols<3>(blocks[0]).lazyProduct(h.template leftCols<3>().transpose());
+  for (int b = 1; b < NB; ++b) {
+    pht.noalias() += P_.template middleCols<3>(blocks[b]).lazyProduct(
+        h.template middleCols<3>(3 * b).transpose());
+  }
+  Eigen::Matrix<double, M, M> S = R;
+  for (int b = 0; b < NB; ++b) {
+    S.noalias() +=
+        h.template middleCols<3>(3 * b).lazyProduct(pht.template middleRows<3>(blocks[b]));
+  }
+  // S = L D L^T. With Z = L^-1 (P H^T)^T and w = L^-1 y (one forward
+  // substitution each), K y = Z^T D^-1 w, K S K^T = Z^T D^-1 Z and
+  // y^T S^-1 y = w^T D^-1 w.
+  LdltSmall<M> ldlt;
+  if (!ldlt.Compute(S)) return false;
+  Eigen::Matrix<double, M, 1> w = y;
+  for (int k = 0; k < M; ++k) {
+    for (int i = k + 1; i < M; ++i) {
+      w(i) -= ldlt.l(i, k) * w(k);
+      pht.col(i) -= ldlt.l(i, k) * pht.col(k);
+    }
+  }
+  const Eigen::Matrix<double, M, 1> w_scaled = w.cwiseProduct(ldlt.inv_d);
+  *nis = w.dot(w_scaled);
   if (!(*nis <= config_.gating_chi2)) return false;  // also rejects NaN
-  const MatNM K = llt.solve(PHt.transpose()).transpose();
-  x_ += K * y;
-  P_ -= K * PHt.transpose();
-  P_ = 0.5 * (P_ + P_.transpose()).eval();
+  x_.noalias() += pht.template topRows<kEkfStateSize>() * w_scaled;
+  // P -= G G^T with G = Z^T D^-1/2 (symmetric to the last bit).
+  for (int k = 0; k < M; ++k) pht.col(k) *= std::sqrt(ldlt.inv_d(k));
+  SubtractGram(pht, &P_);
   return true;
 }
 
-void Ekf::CorrectLegs(const Vector6d& leg_length_m, uint32_t* events) {
+void Ekf::CorrectLegs(const Vector6d& leg_length_m, const EulerAngleTrig& trig, uint32_t* events) {
   Vector6d predicted;
-  MeasurementJacobian<6> H;
-  PredictLegLengths(params_, x_, &predicted, &H);
+  Matrix6d J;
+  PredictLegLengths(params_, Vector6d(x_.segment<6>(kEkfQ)), trig, &predicted, &J);
   const Matrix6d R = Matrix6d::Identity() * leg_variance_m2_;
-  if (Correct<6>(leg_length_m - predicted, H, R, &last_leg_nis_)) {
+  if (Correct<6, 2>(leg_length_m - predicted, {kEkfQ, kEkfQ + 3}, J, R, &last_leg_nis_)) {
     consecutive_leg_rejections_ = 0;
   } else {
     *events |= kGateLegs;
@@ -188,20 +308,25 @@ void Ekf::CorrectLegs(const Vector6d& leg_length_m, uint32_t* events) {
   }
 }
 
-void Ekf::CorrectGyro(const Vector3d& gyro_radps, uint32_t* events) {
+void Ekf::CorrectGyro(const Vector3d& gyro_radps, const EulerAngleTrig& trig, uint32_t* events) {
   Vector3d predicted;
-  MeasurementJacobian<3> H;
-  PredictGyro(x_, &predicted, &H);
+  Eigen::Matrix<double, 3, 9> h;
+  Matrix3d d_angles, d_rates;
+  PredictGyro(trig, Vector6d(x_.segment<6>(kEkfQd)), x_.segment<3>(kEkfGyroBias), &predicted,
+              &d_angles, &d_rates);
+  h << d_angles, d_rates, Matrix3d::Identity();
   double nis = 0.0;
-  if (!Correct<3>(gyro_radps - predicted, H, Matrix3d::Identity() * gyro_variance_, &nis)) {
+  if (!Correct<3, 3>(gyro_radps - predicted, {kEkfQ + 3, kEkfQd + 3, kEkfGyroBias}, h,
+                     Matrix3d::Identity() * gyro_variance_, &nis)) {
     *events |= kGateGyro;
   }
 }
 
-void Ekf::CorrectAccel(const Vector3d& accel_mps2, uint32_t* events) {
+void Ekf::CorrectAccel(const Vector3d& accel_mps2, const EulerAngleTrig& trig, uint32_t* events) {
   Vector3d predicted;
-  MeasurementJacobian<3> H;
-  PredictAccel(x_, qdd_, imu_offset_m_, params_.gravity_mps2, &predicted, &H);
+  AccelJacobians j;
+  PredictAccel(trig, Vector6d(x_.segment<6>(kEkfQd)), qdd_, imu_offset_m_, params_.gravity_mps2,
+               &predicted, &j);
   // The predicted qdd is uncertain by the process model's acceleration noise.
   const double sigma =
       qdd_from_dynamics_ ? config_.dynamics_accel_std_mps2 : config_.process_accel_std_mps2;
@@ -212,23 +337,28 @@ void Ekf::CorrectAccel(const Vector3d& accel_mps2, uint32_t* events) {
     // accelerometer does not correct the pose through the dynamics; without
     // it the innovation covariance ignores the velocity's uncertainty and
     // right after an initialisation good samples are gated.
-    Eigen::Matrix<double, 3, 12> d_state;
-    const Eigen::Matrix<double, 3, 6> d =
-        AccelQddJacobian(x_, qdd_, imu_offset_m_, params_.gravity_mps2);
-    d_state << d * dqdd_dq_, d * dqdd_dqd_;
-    R += d_state * P_.topLeftCorner<12, 12>() * d_state.transpose();
+    // With T = (d_qdd [A B])^T (12x3): R += T^T P_[q,qd] T.
+    const Eigen::Matrix<double, 6, 3> d_t = j.d_qdd.transpose();
+    Eigen::Matrix<double, 12, 3> t;
+    t.topRows<6>().noalias() = dqdd_dq_.transpose() * d_t;
+    t.bottomRows<6>().noalias() = dqdd_dqd_.transpose() * d_t;
+    const Eigen::Matrix<double, 12, 3> pt = P_.topLeftCorner<12, 12>().lazyProduct(t);
+    R.noalias() += t.transpose() * pt;
   }
+  Eigen::Matrix<double, 3, 6> h;
+  h << j.d_angles, j.d_rates;
   double nis = 0.0;
-  if (!Correct<3>(accel_mps2 - predicted, H, R, &nis)) *events |= kGateAccel;
+  if (!Correct<3, 2>(accel_mps2 - predicted, {kEkfQ + 3, kEkfQd + 3}, h, R, &nis)) {
+    *events |= kGateAccel;
+  }
 }
 
 void Ekf::CorrectOrientation(const Vector3d& rpy_rad, uint32_t* events) {
-  MeasurementJacobian<3> H = MeasurementJacobian<3>::Zero();
-  H.block<3, 3>(0, kEkfQ + 3).setIdentity();
   Vector3d y = rpy_rad - x_.segment<3>(kEkfQ + 3);
   for (int i = 0; i < 3; ++i) y(i) = WrapAngle(y(i));
   double nis = 0.0;
-  if (!Correct<3>(y, H, Matrix3d::Identity() * orientation_variance_, &nis)) {
+  if (!Correct<3, 1>(y, {kEkfQ + 3}, Matrix3d::Identity(),
+                     Matrix3d::Identity() * orientation_variance_, &nis)) {
     *events |= kGateOrientation;
   }
 }
@@ -257,20 +387,34 @@ UpdateResult Ekf::Update(const SensorSample& sample) {
     result.has_estimate = true;
     return result;
   }
-  Predict(dt_s, sample.utime, &events);
+  // One sincos per angle per update: the corrections move the angles by
+  // little, so their sines and cosines follow by the angle-sum formulas.
+  Vector3d angles = x_.segment<3>(kEkfQ + 3);
+  EulerAngleTrig trig(angles);
+  const auto follow_angles = [&]() {
+    const Vector3d now = x_.segment<3>(kEkfQ + 3);
+    trig = ShiftEulerAngleTrig(trig, now - angles, now);
+    angles = now;
+  };
+  Predict(dt_s, sample.utime, trig, &events);
   last_utime_ = sample.utime;
-  if (legs_ok) CorrectLegs(sample.leg_length_m, &events);
+  if (legs_ok) {
+    follow_angles();
+    CorrectLegs(sample.leg_length_m, trig, &events);
+  }
   if (sample.imu_valid) {
     if (sample.gyro_radps.allFinite() &&
         sample.gyro_radps.cwiseAbs().maxCoeff() <= config_.max_gyro_radps) {
-      CorrectGyro(sample.gyro_radps, &events);
+      follow_angles();
+      CorrectGyro(sample.gyro_radps, trig, &events);
     } else {
       events |= kRejectGyroInvalid;
     }
     if (config_.use_accelerometer) {
       if (sample.accel_mps2.allFinite() &&
           sample.accel_mps2.cwiseAbs().maxCoeff() <= config_.max_accel_mps2) {
-        CorrectAccel(sample.accel_mps2, &events);
+        follow_angles();
+        CorrectAccel(sample.accel_mps2, trig, &events);
       } else {
         events |= kRejectAccelInvalid;
       }
@@ -288,7 +432,7 @@ UpdateResult Ekf::Update(const SensorSample& sample) {
   // Divergence: the legs keep disagreeing with the estimate, or the filter
   // arithmetic broke down. Either way restart from the legs.
   const bool broken =
-      !x_.allFinite() || !P_.allFinite() ||
+      !AllFinite(x_) || !AllFinite(P_) ||
       P_.diagonal().segment<3>(kEkfQ).maxCoeff() > kMaxPositionStdM * kMaxPositionStdM;
   if (broken || consecutive_leg_rejections_ >= config_.divergence_rejections) {
     events |= kEventDiverged;
@@ -301,6 +445,12 @@ UpdateResult Ekf::Update(const SensorSample& sample) {
   }
   result.has_estimate = true;
   return result;
+}
+
+Ekf::PaddedMatrix Ekf::PaddedIdentity() {
+  PaddedMatrix p = PaddedMatrix::Zero();
+  p.diagonal().head<kEkfStateSize>().setOnes();
+  return p;
 }
 
 Estimate Ekf::estimate() const {

@@ -3,10 +3,13 @@
 // platform state [q, qd] plus the gyro bias. docs/estimator.md describes the
 // model, the tuning and the measured accuracy. No LCM, no heap allocation
 // per update, and time only from the samples' utime.
+#include <array>
+
 #include "stewart/estimator/ekf_types.h"
 #include "stewart/estimator/estimator_config.h"
 #include "stewart/model/actuator_params.h"
 #include "stewart/model/platform_params.h"
+#include "stewart/model/rotation.h"
 #include "stewart/model/sensor_params.h"
 
 namespace stewart {
@@ -31,7 +34,7 @@ class Ekf {
 
   bool initialized() const { return initialized_; }
   const EkfVector& x() const { return x_; }
-  const EkfMatrix& P() const { return P_; }
+  EkfMatrix P() const { return P_.topLeftCorner<kEkfStateSize, kEkfStateSize>(); }
   Estimate estimate() const;
   /// Normalised innovation squared of the last leg update (chi-square, 6 dof).
   double last_leg_nis() const { return last_leg_nis_; }
@@ -40,17 +43,20 @@ class Ekf {
 
  private:
   bool InitializeFromLegs(const SensorSample& sample, uint32_t* events);
-  void Predict(double dt_s, int64_t utime, uint32_t* events);
-  void CorrectLegs(const Vector6d& leg_length_m, uint32_t* events);
-  void CorrectGyro(const Vector3d& gyro_radps, uint32_t* events);
-  void CorrectAccel(const Vector3d& accel_mps2, uint32_t* events);
+  // `trig`: sines and cosines of the current estimate's Euler angles.
+  void Predict(double dt_s, int64_t utime, const EulerAngleTrig& trig, uint32_t* events);
+  void CorrectLegs(const Vector6d& leg_length_m, const EulerAngleTrig& trig, uint32_t* events);
+  void CorrectGyro(const Vector3d& gyro_radps, const EulerAngleTrig& trig, uint32_t* events);
+  void CorrectAccel(const Vector3d& accel_mps2, const EulerAngleTrig& trig, uint32_t* events);
   void CorrectOrientation(const Vector3d& rpy_rad, uint32_t* events);
-  /// Kalman correction with innovation `y`; false (and no change) when the
+  /// Kalman correction with innovation `y` for a measurement whose Jacobian
+  /// is non-zero only in the 3-column state blocks starting at `blocks`
+  /// (`h` holds those blocks side by side); false (and no change) when the
   /// innovation fails the gate.
-  template <int M>
-  bool Correct(const Eigen::Matrix<double, M, 1>& y,
-               const Eigen::Matrix<double, M, kEkfStateSize>& H,
-               const Eigen::Matrix<double, M, M>& R, double* nis);
+  template <int M, int NB>
+  bool Correct(const Eigen::Matrix<double, M, 1>& y, const std::array<int, NB>& blocks,
+               const Eigen::Matrix<double, M, 3 * NB>& h, const Eigen::Matrix<double, M, M>& R,
+               double* nis);
   bool LegsUsable(const SensorSample& sample, uint32_t* events) const;
 
   PlatformParams params_;
@@ -66,7 +72,11 @@ class Ekf {
   bool initialized_ = false;
   int64_t last_utime_ = 0;
   EkfVector x_ = EkfVector::Zero();
-  EkfMatrix P_ = EkfMatrix::Identity();
+  /// P in a 16x16 matrix whose last row and column are zero: every column is
+  /// a whole number of SIMD packets.
+  using PaddedMatrix = Eigen::Matrix<double, kEkfStateSize + 1, kEkfStateSize + 1>;
+  PaddedMatrix P_ = PaddedIdentity();
+  static PaddedMatrix PaddedIdentity();
   Vector6d qdd_ = Vector6d::Zero();
   bool qdd_from_dynamics_ = false;
   Matrix6d dqdd_dq_ = Matrix6d::Zero();  ///< dynamics model, at the last predict

@@ -8,6 +8,7 @@
 // F in N (leg forces, clipped to the actuator limit by the caller), c_v in
 // N/(m/s), qdd in m/s^2 and rad/s^2 (Euler accelerations).
 #include "stewart/model/platform_params.h"
+#include "stewart/model/rotation.h"
 #include "stewart/model/types.h"
 
 namespace stewart {
@@ -15,12 +16,20 @@ namespace stewart {
 Vector6d DynamicsAcceleration(const PlatformParams& params, double friction_nspm, const Vector6d& q,
                               const Vector6d& qd, const Vector6d& force_n);
 
-/// qdd and its Jacobians: dqdd/dq by forward differences, dqdd/dqd from the
-/// friction term only (the Coriolis part is O(|qd|), see the source). Under
-/// force control the platform is a neutrally or un-stably balanced body, so
-/// dqdd/dq must be in the covariance propagation (docs/estimator.md).
+/// qdd and its Jacobians, from one model evaluation and one factor of M:
+/// dqdd/dq analytic from the force, gravity and friction terms (the inertial
+/// part -M^-1 d(M qdd + C qd)/dq, O(|qdd| + |qd|^2), is left out),
+/// dqdd/dqd from the friction term only (the Coriolis part is O(|qd|)); the
+/// derivation and the measured size of what is left out: docs/estimator.md,
+/// "The Jacobian dqdd/dq". Under force control the platform is a neutrally or
+/// un-stably balanced body, so dqdd/dq must be in the covariance propagation.
 void DynamicsAccelerationJacobians(const PlatformParams& params, double friction_nspm,
                                    const Vector6d& q, const Vector6d& qd, const Vector6d& force_n,
                                    Vector6d* qdd, Matrix6d* dqdd_dq, Matrix6d* dqdd_dqd);
+/// The same, given the sines and cosines of q's angles.
+void DynamicsAccelerationJacobians(const PlatformParams& params, double friction_nspm,
+                                   const Vector6d& q, const EulerAngleTrig& trig,
+                                   const Vector6d& qd, const Vector6d& force_n, Vector6d* qdd,
+                                   Matrix6d* dqdd_dq, Matrix6d* dqdd_dqd);
 
 }  // namespace stewart
