@@ -206,6 +206,7 @@ int Rerun(const std::string& dir, long row_number, bool emit_truth) {
   const CampaignSpec spec = LoadSavedSpec(dir);
   const std::string stem = dir + "/run_" + std::to_string(index);
   std::ofstream trajectory(stem + ".csv");
+  trajectory.precision(17);  // every bit: comparable with the LCM run's log
   const CampaignRow row = RunCampaignRow(spec, index, &trajectory);
   const std::string line = CampaignCsvLine(spec, row);
   // Every field but the wall time must be what the campaign wrote.
