@@ -124,6 +124,7 @@ void PlantSimNode::AdvanceTick() {
   plant_.Advance(static_cast<double>(period_us_) * 1e-6);
   const PlantCounters c = plant_.counters();
   health_.SetCounter("endstop_hits", c.endstop_hits);
+  health_.SetCounter("stiff_fallbacks", c.stiff_fallbacks);
   health_.SetCounter("ticks", tick_ + 1);
   if (tick_ % 100 == 0) {
     UpdateLatencyCounters();

@@ -30,7 +30,8 @@ int OdeSizeFor(const ActuatorConfig& actuators) {
 Plant::Plant(const PlantModel& model, const OdeOptions& ode_options)
     : model_(model),
       ode_size_(OdeSizeFor(model.actuators)),
-      integrator_(ode_options, ode_size_, kNumRoots, &Plant::Rhs, &Plant::Roots, this) {}
+      integrator_(ode_options, ode_size_, kNumRoots, &Plant::Rhs, &Plant::Roots, this),
+      ode_options_(ode_options) {}
 
 void Plant::Reset(double t_s, const Vector6d& q, const Vector6d& qd) {
   t_s_ = t_s;
@@ -101,6 +102,33 @@ void Plant::Advance(double dt_s) {
 }
 
 void Plant::IntegrateTo(double t_end) {
+  const double t_start = t_s_;
+  const PlantStateVector x_start = x_;
+  const long hits_start = endstop_hits_;
+  try {
+    IntegrateWith(&integrator_, t_end);
+    return;
+  } catch (const std::runtime_error&) {
+    if (ode_options_.method == OdeMethod::kCvodeBdf) throw;
+  }
+  // The explicit method gave up (step at its minimum): the whole interval
+  // again, from its start, implicitly. Tolerances stay the configured ones.
+  t_s_ = t_start;
+  x_ = x_start;
+  endstop_hits_ = hits_start;
+  if (!stiff_) {
+    OdeOptions stiff_options = ode_options_;
+    stiff_options.method = OdeMethod::kCvodeBdf;
+    stiff_ = std::make_unique<OdeIntegrator>(stiff_options, ode_size_, kNumRoots, &Plant::Rhs,
+                                             &Plant::Roots, this);
+  }
+  ++stiff_fallbacks_;
+  MarkDiscontinuity();
+  IntegrateWith(stiff_.get(), t_end);
+  MarkDiscontinuity();  // the next interval starts the explicit method afresh
+}
+
+void Plant::IntegrateWith(OdeIntegrator* integrator, double t_end) {
   std::array<int, kNumRoots> roots_found{};
   for (int stops = 0;; ++stops) {
     if (stops > kMaxRootStopsPerAdvance) {
@@ -108,12 +136,12 @@ void Plant::IntegrateTo(double t_end) {
           "plant integration chatters at a stroke end at t = " + std::to_string(t_s_) + " s");
     }
     if (restart_pending_) {
-      integrator_.Reinit(t_s_, x_.data());
+      integrator->Reinit(t_s_, x_.data());
       restart_pending_ = false;
     }
     double t_reached = t_s_;
     const OdeIntegrator::Result result =
-        integrator_.Advance(t_end, x_.data(), &t_reached, roots_found.data());
+        integrator->Advance(t_end, x_.data(), &t_reached, roots_found.data());
     t_s_ = t_reached;
     if (result == OdeIntegrator::Result::kReachedTime) break;
     for (int i = 0; i < kNumRoots; ++i) {
@@ -152,6 +180,7 @@ PlantCounters Plant::counters() const {
   PlantCounters c;
   c.endstop_hits = endstop_hits_;
   c.delayed_commands_dropped = delayed_dropped_;
+  c.stiff_fallbacks = stiff_fallbacks_;
   c.ode = integrator_.stats();
   return c;
 }

@@ -207,6 +207,7 @@ json SummarizeCampaign(const CsvTable& runs, const json& meta, double tolerance)
   s["runs_with_infeasible"] = count_positive("infeasible_ticks");
   s["runs_with_endstop_hits"] = count_positive("endstop_hits");
   s["endstop_hits"] = total("endstop_hits");
+  s["runs_with_stiff_fallbacks"] = count_positive("stiff_fallbacks");
   const std::vector<double> completed = column_values("completed");
   json failed = json::array();
   const int failure_col = runs.Column("failure");
@@ -287,7 +288,9 @@ std::string SummaryMarkdown(const json& s) {
   o << "- runs with fallback ticks: " << s["runs_with_fallback"].get<long>()
     << "; with infeasible ticks: " << s["runs_with_infeasible"].get<long>()
     << "; with end-stop hits: " << s["runs_with_endstop_hits"].get<long>() << " ("
-    << s["endstop_hits"].get<double>() << " hits)\n";
+    << s["endstop_hits"].get<double>() << " hits); plant intervals integrated by the stiff "
+       "fallback in "
+    << s.value("runs_with_stiff_fallbacks", 0L) << " runs\n";
   o << "- failed runs: " << s["failed_runs"].size() << "\n";
   for (const json& f : s["failed_runs"]) {
     o << "  - index " << f["index"].get<long>() << ", seed " << f["seed"].get<unsigned long>()

@@ -216,6 +216,7 @@ ClosedLoopSummary RunClosedLoop(const StackConfig& config, const Scenario& scena
     }
   }
   out.endstop_hits = plant.counters().endstop_hits;
+  out.stiff_fallbacks = plant.counters().stiff_fallbacks;
   out.estimator_rejections = estimator_counters.rejected_inputs();
   if (!out.failure.empty()) return out;
   out.q_final = plant.q();

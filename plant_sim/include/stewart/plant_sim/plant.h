@@ -2,6 +2,7 @@
 // The simulated platform: plant state, zero-order-hold inputs and the
 // SUNDIALS integration between control ticks (docs/simulation.md).
 #include <array>
+#include <memory>
 
 #include "stewart/plant_sim/ode_integrator.h"
 #include "stewart/plant_sim/plant_dynamics.h"
@@ -11,6 +12,9 @@ namespace stewart {
 struct PlantCounters {
   long endstop_hits = 0;  ///< times a leg entered an end-stop (stroke end crossed outwards)
   long delayed_commands_dropped = 0;  ///< applied early: the delay queue was full
+  /// Intervals the explicit integrator failed on (stiff end-stop chatter)
+  /// and the implicit BDF fallback integrated instead.
+  long stiff_fallbacks = 0;
   OdeStats ode;
 };
 
@@ -36,7 +40,11 @@ class Plant {
   /// Integrates the held inputs over dt_s (s), switching to each delayed
   /// command at its time. Stops and restarts at every stroke-end crossing
   /// (the end-stop force is not smooth there), counting entries into an
-  /// end-stop. Throws std::runtime_error if SUNDIALS fails.
+  /// end-stop. When the explicit integrator fails (a leg chattering in a
+  /// stiff end-stop can drive its step to the minimum), the interval is
+  /// integrated again from its start by CVODE BDF, which stiffness does not
+  /// stall (counted: counters().stiff_fallbacks). Throws std::runtime_error
+  /// if that fails too.
   void Advance(double dt_s);
 
   double time_s() const { return t_s_; }
@@ -65,6 +73,9 @@ class Plant {
 
   void ApplyForceCommand(const Vector6d& force_cmd_n);
   void IntegrateTo(double t_end);
+  // The integration loop of IntegrateTo with `integrator`, from (t_s_, x_);
+  // throws as OdeIntegrator::Advance does.
+  void IntegrateWith(OdeIntegrator* integrator, double t_end);
   static int Rhs(double t, const double* y, double* y_dot, void* self);
   static int Roots(double t, const double* y, double* g, void* self);
   // A change of the held inputs or a stroke-end crossing: restart, and
@@ -86,6 +97,9 @@ class Plant {
   // one, F_motor = sat(F_cmd) is an input and stays in x_ for output only).
   int ode_size_;
   OdeIntegrator integrator_;
+  OdeOptions ode_options_;
+  std::unique_ptr<OdeIntegrator> stiff_;  // made on the first failure of integrator_
+  long stiff_fallbacks_ = 0;
   PlantInputs inputs_;
   PlantStateVector x_ = PlantStateVector::Zero();
   double t_s_ = 0.0;

@@ -56,6 +56,7 @@ struct ClosedLoopSummary {
   long infeasible_ticks = 0;
   long fallback_ticks = 0;        ///< ticks the safety process answered with its fallback
   long endstop_hits = 0;          ///< legs entering an end-stop (plant)
+  long stiff_fallbacks = 0;       ///< plant intervals the BDF fallback integrated (Plant)
   long estimator_rejections = 0;  ///< sensor samples or updates the estimator rejected
   long saturated_ticks = 0;       ///< ticks where |F*_i| exceeded the actuator force limit
   double max_force_n = 0.0;
