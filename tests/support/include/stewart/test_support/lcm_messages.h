@@ -7,8 +7,10 @@
 #include <cstdint>
 #include <lcm/lcm-cpp.hpp>
 #include <string>
+#include <utility>
 #include <vector>
 
+#include "stewart/safety/diagnostics_lcm.h"
 #include "stewart/safety_diagnostics_t.hpp"
 
 namespace stewart::test {
@@ -36,18 +38,15 @@ struct DiagnosticsGroup {
 /// Sets both groups and their counts.
 inline void SetGroups(const DiagnosticsGroup& position, const DiagnosticsGroup& velocity,
                       safety_diagnostics_t* d) {
-  d->num_position = static_cast<int32_t>(position.names.size());
-  d->position_names = position.names;
-  d->h_position = position.h;
-  d->alpha_h_position = position.alpha_h;
-  d->w_position = position.w;
-  d->mu_position = position.mu;
-  d->num_velocity = static_cast<int32_t>(velocity.names.size());
-  d->velocity_names = velocity.names;
-  d->h_velocity = velocity.h;
-  d->alpha_h_velocity = velocity.alpha_h;
-  d->w_velocity = velocity.w;
-  d->mu_velocity = velocity.mu;
+  for (const auto& [group, fields] : {std::pair{&position, safety::PositionGroup(d)},
+                                      std::pair{&velocity, safety::VelocityGroup(d)}}) {
+    *fields.num = static_cast<int32_t>(group->names.size());
+    *fields.names = group->names;
+    *fields.h = group->h;
+    *fields.alpha_h = group->alpha_h;
+    *fields.w = group->w;
+    *fields.mu = group->mu;
+  }
 }
 
 }  // namespace stewart::test
