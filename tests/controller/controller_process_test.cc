@@ -1,9 +1,6 @@
 // The real controller process over LCM on a private URL (ports 7780-7789).
 #include <gtest/gtest.h>
 #include <signal.h>
-#include <spawn.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <chrono>
 #include <cmath>
@@ -18,50 +15,12 @@
 #include "stewart/node/lcm_handle.h"
 #include "stewart/setpoint_t.hpp"
 #include "stewart/state_t.hpp"
-
-extern char** environ;
+#include "stewart/test_support/child_process.h"
 
 namespace stewart {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-class Process {
- public:
-  explicit Process(std::vector<std::string> args) {
-    std::vector<char*> argv;
-    for (auto& a : args) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    if (posix_spawn(&pid_, argv[0], nullptr, nullptr, argv.data(), environ) != 0) pid_ = -1;
-  }
-  ~Process() {
-    if (pid_ > 0 && !exited_) {
-      kill(pid_, SIGTERM);
-      Wait(std::chrono::seconds(5));
-      if (!exited_) kill(pid_, SIGKILL);
-      waitpid(pid_, nullptr, 0);
-    }
-  }
-  bool started() const { return pid_ > 0; }
-  /// Exit status, or -1 if still running after `timeout`.
-  int Wait(Clock::duration timeout) {
-    const auto end = Clock::now() + timeout;
-    while (Clock::now() < end) {
-      int status = 0;
-      if (waitpid(pid_, &status, WNOHANG) == pid_) {
-        exited_ = true;
-        return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-      }
-      usleep(10000);
-    }
-    return -1;
-  }
-  void Terminate() { kill(pid_, SIGTERM); }
-
- private:
-  pid_t pid_ = -1;
-  bool exited_ = false;
-};
 
 struct Inbox {
   std::vector<force_command_t> commands;
@@ -130,7 +89,7 @@ class ControllerProcess : public ::testing::Test {
 
 TEST_F(ControllerProcess, AnswersStatesWithTheirSampleUtime) {
   Connect(7780);
-  Process p({CONTROLLER_PATH, "--lcm-url", url_});
+  test::ChildProcess p({CONTROLLER_PATH, "--lcm-url", url_});
   ASSERT_TRUE(p.started());
   const int first = PublishUntilAnswered(State(1'000'000, Config().home_pose));
   ASSERT_GE(first, 0) << "no force_command_t from the controller";
@@ -173,7 +132,7 @@ TEST_F(ControllerProcess, AnswersStatesWithTheirSampleUtime) {
 
   // The health heartbeat counts both rejections.
   inbox_.health.clear();
-  p.Terminate();
+  p.Signal(SIGTERM);
   EXPECT_EQ(p.Wait(std::chrono::seconds(5)), 0);
   Drain(100);
   ASSERT_FALSE(inbox_.health.empty());
@@ -195,7 +154,7 @@ TEST_F(ControllerProcess, FollowsAScenarioEchoesItAndExitsAtTheEnd) {
   std::ofstream(path) << "name: short\nduration_s: 0.5\nsegments:\n"
                          "  - {start_s: 0, type: step, q_des: [0.02, 0, 0.4, 0, 0, 0]}\n"
                          "  - {start_s: 0.25, type: step, q_des: [0, 0.03, 0.41, 0, 0, 0]}\n";
-  Process p({CONTROLLER_PATH, "--lcm-url", url_, "--scenario", path, "--exit-at-end"});
+  test::ChildProcess p({CONTROLLER_PATH, "--lcm-url", url_, "--scenario", path, "--exit-at-end"});
   ASSERT_TRUE(p.started());
   const int64_t t0 = 5'000'000;
   const int first = PublishUntilAnswered(State(t0, Config().home_pose));

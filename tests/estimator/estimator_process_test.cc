@@ -3,8 +3,6 @@
 // counted in its health; the perfect-state pass-through only on request.
 #include <gtest/gtest.h>
 #include <signal.h>
-#include <spawn.h>
-#include <sys/wait.h>
 
 #include <chrono>
 #include <cmath>
@@ -20,42 +18,13 @@
 #include "stewart/node/lcm_handle.h"
 #include "stewart/sensor_t.hpp"
 #include "stewart/state_t.hpp"
-
-extern char** environ;
+#include "stewart/test_support/child_process.h"
 
 namespace stewart::test {
 namespace {
 
 constexpr int kPortEstimate = 7720;  // this file's private LCM ports
 constexpr int kPortPerfect = 7721;
-
-// Starts the estimator binary; SIGTERM and reaps it on destruction.
-class Process {
- public:
-  explicit Process(std::vector<std::string> args) {
-    args.insert(args.begin(), ESTIMATOR_BINARY);
-    std::vector<char*> argv;
-    for (auto& a : args) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    ok_ = posix_spawn(&pid_, ESTIMATOR_BINARY, nullptr, nullptr, argv.data(), environ) == 0;
-  }
-  ~Process() {
-    if (ok_ && !stopped_) Stop();
-  }
-  int Stop() {
-    stopped_ = true;
-    kill(pid_, SIGTERM);
-    int status = 0;
-    waitpid(pid_, &status, 0);
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  }
-  bool ok() const { return ok_; }
-
- private:
-  pid_t pid_ = 0;
-  bool ok_ = false;
-  bool stopped_ = false;
-};
 
 class Sink {
  public:
@@ -110,8 +79,9 @@ TEST(EstimatorProcess, EstimatesCarryTheSensorSampleUtime) {
   Sink sink;
   lcm->subscribe(ch.state_estimate, &Sink::OnState, &sink)->setQueueCapacity(2000);
   lcm->subscribe(ch.health, &Sink::OnHealth, &sink)->setQueueCapacity(100);
-  Process proc({"--config", DefaultConfigPath(), "--lcm-url", url, "--log-level", "error"});
-  ASSERT_TRUE(proc.ok());
+  ChildProcess proc({ESTIMATOR_BINARY, "--config", DefaultConfigPath(), "--lcm-url", url,
+                     "--log-level", "error"});
+  ASSERT_TRUE(proc.started());
   // Its first heartbeat: the process is up and subscribed.
   ASSERT_TRUE(PumpUntil(
       lcm.get(), [&] { return !sink.health.empty(); }, 10.0));
@@ -178,7 +148,7 @@ TEST(EstimatorProcess, EstimatesCarryTheSensorSampleUtime) {
   EXPECT_EQ(Counter(h, "rejected_legs_non_finite"), 1);
   EXPECT_EQ(Counter(h, "rejected_non_increasing_time"), 1);
   EXPECT_EQ(h.messages_out, kSamples);
-  EXPECT_EQ(proc.Stop(), 0);
+  EXPECT_EQ(proc.Stop(SIGTERM), 0);
 }
 
 TEST(EstimatorProcess, PerfectStateOnlyOnRequest) {
@@ -189,9 +159,9 @@ TEST(EstimatorProcess, PerfectStateOnlyOnRequest) {
   Sink sink;
   lcm->subscribe(ch.state_estimate, &Sink::OnState, &sink);
   lcm->subscribe(ch.health, &Sink::OnHealth, &sink);
-  Process proc({"--config", DefaultConfigPath(), "--lcm-url", url, "--log-level", "error",
-                "--perfect-state"});
-  ASSERT_TRUE(proc.ok());
+  ChildProcess proc({ESTIMATOR_BINARY, "--config", DefaultConfigPath(), "--lcm-url", url,
+                     "--log-level", "error", "--perfect-state"});
+  ASSERT_TRUE(proc.started());
   ASSERT_TRUE(PumpUntil(
       lcm.get(), [&] { return !sink.health.empty(); }, 10.0));
   state_t truth{};
@@ -206,7 +176,7 @@ TEST(EstimatorProcess, PerfectStateOnlyOnRequest) {
   EXPECT_EQ(sink.states[0].sample_utime, 5000);
   EXPECT_DOUBLE_EQ(sink.states[0].q[2], 0.4);
   EXPECT_EQ(sink.states[0].status, state_t::STATUS_VALID | state_t::STATUS_PERFECT_STATE);
-  EXPECT_EQ(proc.Stop(), 0);
+  EXPECT_EQ(proc.Stop(SIGTERM), 0);
 }
 
 }  // namespace
