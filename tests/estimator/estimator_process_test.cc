@@ -7,6 +7,8 @@
 #include <chrono>
 #include <cmath>
 #include <map>
+#include <memory>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -71,20 +73,36 @@ int64_t Counter(const health_t& h, const std::string& name) {
   return 0;
 }
 
-TEST(EstimatorProcess, EstimatesCarryTheSensorSampleUtime) {
+/// The estimator process on a private LCM URL; the test publishes its inputs
+/// on `lcm` and finds its estimates and heartbeats in `sink`.
+class EstimatorProcess : public ::testing::Test {
+ protected:
+  /// Starts it with `flags` and waits for its first heartbeat (the process
+  /// is up and subscribed).
+  void Start(int port, const std::vector<std::string>& flags) {
+    const std::string url = PrivateLcmUrl(port);
+    lcm = MakeLcm(url);
+    lcm->subscribe(ch.state_estimate, &Sink::OnState, &sink)->setQueueCapacity(2000);
+    lcm->subscribe(ch.health, &Sink::OnHealth, &sink)->setQueueCapacity(100);
+    std::vector<std::string> argv = {ESTIMATOR_BINARY, "--config", DefaultConfigPath(),
+                                     "--lcm-url",      url,        "--log-level",
+                                     "error"};
+    argv.insert(argv.end(), flags.begin(), flags.end());
+    proc.emplace(argv);
+    ASSERT_TRUE(proc->started());
+    ASSERT_TRUE(PumpUntil(
+        lcm.get(), [&] { return !sink.health.empty(); }, 10.0));
+  }
+
   const StackConfig config = LoadStackConfig(DefaultConfigPath());
   const ChannelNames& ch = config.lcm.channels;
-  const std::string url = PrivateLcmUrl(kPortEstimate);
-  auto lcm = MakeLcm(url);
+  std::unique_ptr<lcm::LCM> lcm;
   Sink sink;
-  lcm->subscribe(ch.state_estimate, &Sink::OnState, &sink)->setQueueCapacity(2000);
-  lcm->subscribe(ch.health, &Sink::OnHealth, &sink)->setQueueCapacity(100);
-  ChildProcess proc({ESTIMATOR_BINARY, "--config", DefaultConfigPath(), "--lcm-url", url,
-                     "--log-level", "error"});
-  ASSERT_TRUE(proc.started());
-  // Its first heartbeat: the process is up and subscribed.
-  ASSERT_TRUE(PumpUntil(
-      lcm.get(), [&] { return !sink.health.empty(); }, 10.0));
+  std::optional<ChildProcess> proc;
+};
+
+TEST_F(EstimatorProcess, EstimatesCarryTheSensorSampleUtime) {
+  ASSERT_NO_FATAL_FAILURE(Start(kPortEstimate, {}));
 
   ScenarioTruth truth(config, 11);
   constexpr int kSamples = 600;
@@ -148,22 +166,11 @@ TEST(EstimatorProcess, EstimatesCarryTheSensorSampleUtime) {
   EXPECT_EQ(Counter(h, "rejected_legs_non_finite"), 1);
   EXPECT_EQ(Counter(h, "rejected_non_increasing_time"), 1);
   EXPECT_EQ(h.messages_out, kSamples);
-  EXPECT_EQ(proc.Stop(SIGTERM), 0);
+  EXPECT_EQ(proc->Stop(SIGTERM), 0);
 }
 
-TEST(EstimatorProcess, PerfectStateOnlyOnRequest) {
-  const StackConfig config = LoadStackConfig(DefaultConfigPath());
-  const ChannelNames& ch = config.lcm.channels;
-  const std::string url = PrivateLcmUrl(kPortPerfect);
-  auto lcm = MakeLcm(url);
-  Sink sink;
-  lcm->subscribe(ch.state_estimate, &Sink::OnState, &sink);
-  lcm->subscribe(ch.health, &Sink::OnHealth, &sink);
-  ChildProcess proc({ESTIMATOR_BINARY, "--config", DefaultConfigPath(), "--lcm-url", url,
-                     "--log-level", "error", "--perfect-state"});
-  ASSERT_TRUE(proc.started());
-  ASSERT_TRUE(PumpUntil(
-      lcm.get(), [&] { return !sink.health.empty(); }, 10.0));
+TEST_F(EstimatorProcess, PerfectStateOnlyOnRequest) {
+  ASSERT_NO_FATAL_FAILURE(Start(kPortPerfect, {"--perfect-state"}));
   state_t truth{};
   truth.utime = 5000;
   truth.seq = 9;
@@ -176,7 +183,7 @@ TEST(EstimatorProcess, PerfectStateOnlyOnRequest) {
   EXPECT_EQ(sink.states[0].sample_utime, 5000);
   EXPECT_DOUBLE_EQ(sink.states[0].q[2], 0.4);
   EXPECT_EQ(sink.states[0].status, state_t::STATUS_VALID | state_t::STATUS_PERFECT_STATE);
-  EXPECT_EQ(proc.Stop(SIGTERM), 0);
+  EXPECT_EQ(proc->Stop(SIGTERM), 0);
 }
 
 }  // namespace
