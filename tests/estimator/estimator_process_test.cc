@@ -21,6 +21,7 @@
 #include "stewart/sensor_t.hpp"
 #include "stewart/state_t.hpp"
 #include "stewart/test_support/child_process.h"
+#include "stewart/test_support/lcm_messages.h"
 
 namespace stewart::test {
 namespace {
@@ -39,18 +40,6 @@ class Sink {
   std::vector<state_t> states;
   std::vector<health_t> health;
 };
-
-template <typename Pred>
-bool PumpUntil(lcm::LCM* lcm, Pred done, double timeout_s) {
-  const auto deadline = std::chrono::steady_clock::now() +
-                        std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                            std::chrono::duration<double>(timeout_s));
-  while (!done()) {
-    if (std::chrono::steady_clock::now() > deadline) return false;
-    lcm->handleTimeout(20);
-  }
-  return true;
-}
 
 sensor_t ToMessage(const SensorSample& s, int64_t seq) {
   sensor_t m{};
@@ -90,7 +79,7 @@ class EstimatorProcess : public ::testing::Test {
     argv.insert(argv.end(), flags.begin(), flags.end());
     proc.emplace(argv);
     ASSERT_TRUE(proc->started());
-    ASSERT_TRUE(PumpUntil(
+    ASSERT_TRUE(HandleUntil(
         lcm.get(), [&] { return !sink.health.empty(); }, 10.0));
   }
 
@@ -131,7 +120,7 @@ TEST_F(EstimatorProcess, EstimatesCarryTheSensorSampleUtime) {
     lcm->handleTimeout(0);
     std::this_thread::sleep_for(std::chrono::microseconds(300));
   }
-  ASSERT_TRUE(PumpUntil(
+  ASSERT_TRUE(HandleUntil(
       lcm.get(), [&] { return sink.states.size() >= kSamples; }, 10.0))
       << "received " << sink.states.size();
   ASSERT_EQ(sink.states.size(), static_cast<size_t>(kSamples));
@@ -154,7 +143,7 @@ TEST_F(EstimatorProcess, EstimatesCarryTheSensorSampleUtime) {
     EXPECT_LT(last.q_std[j], 2e-4);
   }
   // Health: the NaN legs and the duplicate are counted rejections.
-  ASSERT_TRUE(PumpUntil(
+  ASSERT_TRUE(HandleUntil(
       lcm.get(), [&] { return sink.health.back().messages_in >= 2 * kSamples; }, 5.0));
   const health_t& h = sink.health.back();
   std::string counters;
@@ -178,7 +167,7 @@ TEST_F(EstimatorProcess, PerfectStateOnlyOnRequest) {
   truth.q[2] = 0.4;
   truth.status = state_t::STATUS_GROUND_TRUTH;
   lcm->publish(ch.state_truth, &truth);
-  ASSERT_TRUE(PumpUntil(
+  ASSERT_TRUE(HandleUntil(
       lcm.get(), [&] { return !sink.states.empty(); }, 5.0));
   EXPECT_EQ(sink.states[0].sample_utime, 5000);
   EXPECT_DOUBLE_EQ(sink.states[0].q[2], 0.4);

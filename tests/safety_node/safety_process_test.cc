@@ -14,19 +14,12 @@
 #include "stewart/node/lcm_handle.h"
 #include "stewart/state_t.hpp"
 #include "stewart/test_support/child_process.h"
+#include "stewart/test_support/lcm_messages.h"
 
 namespace stewart {
 namespace {
 
 constexpr int kPort = 7810;  // this test's private LCM port
-
-class SafeSink {
- public:
-  void OnSafe(const lcm::ReceiveBuffer*, const std::string&, const force_command_t* msg) {
-    received.push_back(*msg);
-  }
-  std::vector<force_command_t> received;
-};
 
 state_t MakeState(int64_t utime, const Vector6d& q) {
   state_t s{};
@@ -38,20 +31,17 @@ state_t MakeState(int64_t utime, const Vector6d& q) {
   return s;
 }
 
-bool WaitFor(lcm::LCM* lcm, const SafeSink& sink, std::size_t count) {
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(5);
-  while (sink.received.size() < count && std::chrono::steady_clock::now() < deadline) {
-    lcm->handleTimeout(50);
-  }
-  return sink.received.size() >= count;
+bool WaitFor(lcm::LCM* lcm, const test::Inbox<force_command_t>& sink, std::size_t count) {
+  return test::HandleUntil(
+      lcm, [&] { return sink.received.size() >= count; }, 5.0, 50);
 }
 
 TEST(SafetyProcess, FiltersNominalAndFallsBackWhenControllerStops) {
   const StackConfig config = LoadStackConfig(DefaultConfigPath());
   const std::string url = PrivateLcmUrl(kPort);
   auto lcm = MakeLcm(url);
-  SafeSink sink;
-  lcm->subscribe(config.lcm.channels.command_safe, &SafeSink::OnSafe, &sink);
+  test::Inbox<force_command_t> sink;
+  lcm->subscribe(config.lcm.channels.command_safe, &test::Inbox<force_command_t>::On, &sink);
   test::ChildProcess process({SAFETY_PATH, "--lcm-url", url, "--log-level", "warn"});
   EXPECT_TRUE(process.started());
   // Give the process time to subscribe: resend the first state until the

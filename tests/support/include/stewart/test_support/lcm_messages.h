@@ -1,9 +1,10 @@
 #pragma once
-// Building LCM messages and logs in tests: a message appended to an LCM log
-// file as the logger would record it, and the variable-length barrier groups
-// of a safety_diagnostics_t filled in one call.
+// LCM messages and logs in tests: a message appended to an LCM log file as
+// the logger would record it, the variable-length barrier groups of a
+// safety_diagnostics_t filled in one call, and the messages a test receives.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cstdint>
 #include <lcm/lcm-cpp.hpp>
 #include <string>
@@ -47,6 +48,30 @@ inline void SetGroups(const DiagnosticsGroup& position, const DiagnosticsGroup& 
     *fields.w = group->w;
     *fields.mu = group->mu;
   }
+}
+
+/// Every message of one type a subscription received, in order:
+/// `lcm->subscribe(channel, &Inbox<Msg>::On, &inbox)`.
+template <typename Msg>
+struct Inbox {
+  void On(const lcm::ReceiveBuffer*, const std::string&, const Msg* msg) {
+    received.push_back(*msg);
+  }
+  std::vector<Msg> received;
+};
+
+/// Handles `lcm`'s messages until `done()` or `timeout_s` has passed:
+/// whether `done()`.
+template <typename Done>
+bool HandleUntil(lcm::LCM* lcm, Done done, double timeout_s, int step_ms = 20) {
+  const auto deadline = std::chrono::steady_clock::now() +
+                        std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                            std::chrono::duration<double>(timeout_s));
+  while (!done()) {
+    if (std::chrono::steady_clock::now() > deadline) return false;
+    lcm->handleTimeout(step_ms);
+  }
+  return true;
 }
 
 }  // namespace stewart::test
