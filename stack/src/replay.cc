@@ -172,7 +172,9 @@ RecordedLog ReadLog(const std::string& path, const ChannelNames& channels) {
       index = static_cast<int>(log.diagnostics.size());
       if (Decode(*event, &diagnostics)) {
         log.diagnostics.push_back({diagnostics.sample_utime, diagnostics.compute_ns,
-                                   diagnostics.variant, diagnostics.force_limits != 0});
+                                   diagnostics.variant, diagnostics.force_limits != 0,
+                                   diagnostics.active_case, diagnostics.fallback_reason,
+                                   diagnostics.flags});
         stamp = Stamp{diagnostics.seq, diagnostics.utime};
       }
     } else {
@@ -277,8 +279,10 @@ SafetyReplayResult ReplaySafety(const StackConfig& config, const RecordedLog& lo
     if (recorded != nullptr && IsFallback(recorded->flags)) ++r.answered_by_fallback;
   }
 
-  // One safe command the process published, against the recorded one.
+  // One safe command the process published, against the recorded one; its
+  // diagnostics (case, fallback reason, flags) against the recorded ones.
   std::vector<int64_t> replayed_ns, recorded_ns;
+  safety_diagnostics_t replayed_diagnostics;  // reused: keeps its capacities
   auto compare = [&](const safety::SafetyOutput& out, bool watchdog_in_gap) {
     SafetyStep step;
     step.sample_utime = out.command.sample_utime;
@@ -295,10 +299,18 @@ SafetyReplayResult ReplaySafety(const StackConfig& config, const RecordedLog& lo
     }
     std::copy(std::begin(recorded->force_n), std::end(recorded->force_n), step.f_recorded.begin());
     step.recorded_flags = recorded->flags;
+    bool diagnostics_equal = true;
     if (const int* diag_index = Find(diagnostics_of, step.sample_utime)) {
-      step.recorded_ns = log.diagnostics[static_cast<size_t>(*diag_index)].compute_ns;
+      const RecordedDiagnostics& d = log.diagnostics[static_cast<size_t>(*diag_index)];
+      step.recorded_ns = d.compute_ns;
+      safety::FillDiagnosticsMessage(process.filter(), out, &replayed_diagnostics);
+      diagnostics_equal = d.active_case == replayed_diagnostics.active_case &&
+                          d.fallback_reason == replayed_diagnostics.fallback_reason &&
+                          d.flags == replayed_diagnostics.flags;
+      if (!diagnostics_equal && !watchdog_in_gap) ++r.diagnostics_differ;
     }
     const bool flags_equal = recorded->flags == step.replayed_flags;
+    const bool others_equal = flags_equal && diagnostics_equal;
     if (watchdog_in_gap) {
       // The live watchdog had nominal commands the log lacks.
       step.kind = SafetyStepKind::kLogGap;
@@ -312,11 +324,11 @@ SafetyReplayResult ReplaySafety(const StackConfig& config, const RecordedLog& lo
       } else {
         ++r.fallback_by_filter;
       }
-      r.fallback.Add(step.sample_utime, step.f_replayed.data(), recorded->force_n, 6, flags_equal);
+      r.fallback.Add(step.sample_utime, step.f_replayed.data(), recorded->force_n, 6, others_equal);
     } else {
       step.kind = SafetyStepKind::kCompared;
       if (!flags_equal) ++r.flags_differ;
-      r.filter.Add(step.sample_utime, step.f_replayed.data(), recorded->force_n, 6, flags_equal);
+      r.filter.Add(step.sample_utime, step.f_replayed.data(), recorded->force_n, 6, others_equal);
       replayed_ns.push_back(step.replayed_ns);
       if (step.recorded_ns >= 0) recorded_ns.push_back(step.recorded_ns);
     }

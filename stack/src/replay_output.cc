@@ -71,6 +71,7 @@ ordered_json ToJson(const SafetyReplayResult& s, const std::string& variant_sour
   j["log_gap"] = s.log_gap;
   j.update(ToJson(s.filter, "_n"));
   j["flags_differ"] = s.flags_differ;
+  j["diagnostics_differ"] = s.diagnostics_differ;
   ordered_json fallback = {{"recorded", s.fallback_commands},
                            {"stale_input", s.fallback_stale_input},
                            {"invalid_state", s.fallback_invalid_state},
@@ -223,8 +224,9 @@ std::string FormatSummary(const ReplayReport& report) {
         s.states, s.nominal_commands, s.without_state);
     o += fmt::format("  safe commands         {} replayed, {} recorded\n", s.commands.replayed,
                      s.commands.recorded);
-    o += fmt::format("  filter commands       {}; {}; flags differ {}\n", Identical(s.filter),
-                     Worst(s.filter, "N"), s.flags_differ);
+    o += fmt::format("  filter commands       {}; {}; flags differ {}, diagnostics differ {}\n",
+                     Identical(s.filter), Worst(s.filter, "N"), s.flags_differ,
+                     s.diagnostics_differ);
     o += fmt::format(
         "  answered by fallback  {} nominal commands (the live process sent a fallback; "
         "compared below)\n",

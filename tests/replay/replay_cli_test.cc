@@ -88,9 +88,11 @@ class ReplayCli : public ::testing::Test {
   /// publishes them, each in the order the logger would receive it. With
   /// `tamper_sample` >= 0 that sample's recorded force 0 is one ulp off;
   /// samples [drop_from, drop_from + drop_count) are left out of the log, as
-  /// lcm-logger loses a burst (the process still had them).
+  /// lcm-logger loses a burst (the process still had them); with
+  /// `tamper_case_sample` >= 0 that sample's recorded diagnostics name
+  /// another case.
   std::string MakeRun(const std::string& name, int tamper_sample = -1, int drop_from = -1,
-                      int drop_count = 0) {
+                      int drop_count = 0, int tamper_case_sample = -1) {
     const std::string run = root_ + "/" + name;
     fs::create_directories(run);
     const std::string config_path = std::string(STEWART_SOURCE_DIR) + "/config/platform.yaml";
@@ -112,6 +114,7 @@ class ReplayCli : public ::testing::Test {
       if (k == tamper_sample) safe.force_n[0] = std::nextafter(safe.force_n[0], 1e9);
       safety_diagnostics_t diag{};
       safety::FillDiagnosticsMessage(process.filter(), out, &diag);
+      if (k == tamper_case_sample) diag.active_case = diag.active_case == 0 ? 1 : 0;
       if (dropped) return;
       test::AppendToLog(&log, ch.command_safe, safe, timestamp++);
       test::AppendToLog(&log, ch.safety_diagnostics, diag, timestamp++);
@@ -293,6 +296,19 @@ TEST_F(ReplayCli, MessagesLostByTheLoggerAreFoundAndNotCompared) {
                           ": 7 messages published but not in the log"),
             std::string::npos)
       << r.output;
+}
+
+// The replayed diagnostics are compared too: one recorded case changed makes
+// its step differ although the command is bit-identical.
+TEST_F(ReplayCli, DifferentRecordedDiagnosticsFailExpectIdentical) {
+  CommandResult r;
+  const nlohmann::json j = ReplayJson(MakeRun("run", -1, -1, 0, 150), "--expect-identical", &r);
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  const nlohmann::json& s = j.at("safety");
+  EXPECT_EQ(s.at("diagnostics_differ"), 1);
+  EXPECT_EQ(s.at("flags_differ"), 0);
+  EXPECT_EQ(s.at("max_abs_diff_n"), 0.0);
+  EXPECT_EQ(s.at("identical").get<long>(), s.at("compared").get<long>() - 1);
 }
 
 // A burst lost by the logger longer than safety.stale_age_s: the replayed

@@ -43,6 +43,9 @@ struct RecordedDiagnostics {
   int64_t compute_ns = 0;
   int8_t variant = 0;  ///< safety_diagnostics_t::VARIANT_*
   bool force_limits = false;
+  int8_t active_case = 0;       ///< safety_diagnostics_t::CASE_*
+  int32_t fallback_reason = 0;  ///< force_command_t::FLAG_* that caused a fallback
+  int32_t flags = 0;            ///< the filter step's force_command_t::FLAG_*
 };
 
 enum class Channel {
@@ -170,8 +173,13 @@ struct SafetyReplayResult {
   long without_state = 0;         ///< nominal commands without a recorded estimate of their sample
   long answered_by_fallback = 0;  ///< nominal commands whose recorded safe command is a fallback
   OutputPairing commands;         ///< the safe commands the replay published vs the recorded
-  DiffStats filter;               ///< kCompared: the filter's commands, replay vs recorded
-  long flags_differ = 0;          ///< among them, force_command_t.flags differ
+  /// kCompared: the filter's commands, replay vs recorded; identical also needs
+  /// equal flags and, where recorded, equal diagnostics (case, fallback reason, flags).
+  DiffStats filter;
+  long flags_differ = 0;  ///< among them, force_command_t.flags differ
+  /// Compared commands (either kind) whose recorded diagnostics differ from
+  /// the replayed ones in case, fallback reason or flags.
+  long diagnostics_differ = 0;
 
   /// Every recorded fallback command (FLAG_FALLBACK or FLAG_STALE_INPUT), by
   /// the path the replayed process took for it (kFallback steps).
