@@ -89,6 +89,12 @@ int ConfigNode::Int(std::string_view key) const {
   return value;
 }
 
+int ConfigNode::IntInRange(std::string_view key, int lo, int hi, const std::string& reason) const {
+  const int value = Int(key);
+  if (value < lo || value > hi) Fail(key, reason);
+  return value;
+}
+
 bool ConfigNode::Bool(std::string_view key) const {
   const YAML::Node node = Required(key);
   bool value = false;

@@ -1,3 +1,5 @@
+#include <climits>
+
 #include "stewart/config/sections.h"
 
 namespace stewart {
@@ -20,12 +22,11 @@ EstimatorConfig ParseEstimatorConfig(const ConfigNode& estimator) {
   e.leg_noise_inflation = estimator.PositiveDouble("leg_noise_inflation");
   e.use_accelerometer = estimator.Bool("use_accelerometer");
   e.gating_chi2 = estimator.PositiveDouble("gating_chi2");
-  e.divergence_rejections = estimator.Int("divergence_rejections");
-  if (e.divergence_rejections < 1) estimator.Fail("divergence_rejections", "must be >= 1");
+  e.divergence_rejections =
+      estimator.IntInRange("divergence_rejections", 1, INT_MAX, "must be >= 1");
   e.max_dt_s = estimator.PositiveDouble("max_dt_s");
   e.command_timeout_s = estimator.PositiveDouble("command_timeout_s");
-  e.settle_samples = estimator.Int("settle_samples");
-  if (e.settle_samples < 0) estimator.Fail("settle_samples", "must not be negative");
+  e.settle_samples = estimator.IntInRange("settle_samples", 0, INT_MAX, "must not be negative");
   e.max_gyro_radps = estimator.PositiveDouble("max_gyro_radps");
   e.max_accel_mps2 = estimator.PositiveDouble("max_accel_mps2");
   e.leg_range_margin_m = estimator.NonNegativeDouble("leg_range_margin_m");

@@ -1,3 +1,4 @@
+#include <climits>
 #include <cmath>
 
 #include "stewart/config/sections.h"
@@ -9,15 +10,11 @@ HwBridgeConfig ParseHwBridgeConfig(const ConfigNode& hw_bridge) {
   h.transport = hw_bridge.Choice("transport", {"udp", "serial"});
   h.device_host = hw_bridge.String("device_host");
   h.local_host = hw_bridge.String("local_host");
-  for (const char* key : {"device_port", "local_port"}) {
-    const int port = hw_bridge.Int(key);
-    if (port < 0 || port > 65535) hw_bridge.Fail(key, "must be a UDP port 0..65535");
-  }
-  h.device_port = hw_bridge.Int("device_port");
-  h.local_port = hw_bridge.Int("local_port");
+  const std::string udp_port = "must be a UDP port 0..65535";
+  h.device_port = hw_bridge.IntInRange("device_port", 0, 65535, udp_port);
+  h.local_port = hw_bridge.IntInRange("local_port", 0, 65535, udp_port);
   h.serial_device = hw_bridge.String("serial_device");
-  h.serial_baud = hw_bridge.Int("serial_baud");
-  if (h.serial_baud <= 0) hw_bridge.Fail("serial_baud", "must be positive");
+  h.serial_baud = hw_bridge.IntInRange("serial_baud", 1, INT_MAX, "must be positive");
   h.command_timeout_s = hw_bridge.PositiveDouble("command_timeout_s");
   h.device_watchdog_s = hw_bridge.PositiveDouble("device_watchdog_s");
   // The frame carries the watchdog in whole microseconds, 1 ms .. 1 s.
@@ -28,12 +25,10 @@ HwBridgeConfig ParseHwBridgeConfig(const ConfigNode& hw_bridge) {
   h.late_frame_s = hw_bridge.PositiveDouble("late_frame_s");
   h.clock_drift_ppm = hw_bridge.NonNegativeDouble("clock_drift_ppm");
 
-  h.adc_max_count = hw_bridge.Int("adc_max_count");
-  if (h.adc_max_count < 1 || h.adc_max_count > 65535) {
-    hw_bridge.Fail("adc_max_count", "must be within [1, 65535] (uint16 on the wire)");
-  }
-  h.adc_fault_margin_counts = hw_bridge.Int("adc_fault_margin_counts");
-  if (h.adc_fault_margin_counts < 0) hw_bridge.Fail("adc_fault_margin_counts", "must be >= 0");
+  h.adc_max_count = hw_bridge.IntInRange("adc_max_count", 1, 65535,
+                                         "must be within [1, 65535] (uint16 on the wire)");
+  h.adc_fault_margin_counts =
+      hw_bridge.IntInRange("adc_fault_margin_counts", 0, INT_MAX, "must be >= 0");
   h.adc_retracted = hw_bridge.Vec6("adc_retracted");
   h.adc_extended = hw_bridge.Vec6("adc_extended");
   for (int i = 0; i < 6; ++i) {

@@ -1,3 +1,4 @@
+#include <climits>
 #include <cmath>
 
 #include "stewart/config/sections.h"
@@ -8,10 +9,7 @@ SensorConfig ParseSensorConfig(const ConfigNode& sensors) {
   SensorConfig s;
   s.rate_hz = sensors.PositiveDouble("rate_hz");
   s.leg_pot_noise_std_m = sensors.NonNegativeDouble("leg_pot_noise_std_m");
-  s.leg_adc_bits = sensors.Int("leg_adc_bits");
-  if (s.leg_adc_bits < 0 || s.leg_adc_bits > 24) {
-    sensors.Fail("leg_adc_bits", "must be 0 (no quantisation) to 24");
-  }
+  s.leg_adc_bits = sensors.IntInRange("leg_adc_bits", 0, 24, "must be 0 (no quantisation) to 24");
   s.gyro_noise_std_radps = sensors.NonNegativeDouble("gyro_noise_std_radps");
   s.gyro_bias_radps = sensors.Vec3("gyro_bias_radps");
   s.accel_noise_std_mps2 = sensors.NonNegativeDouble("accel_noise_std_mps2");
@@ -19,9 +17,7 @@ SensorConfig ParseSensorConfig(const ConfigNode& sensors) {
   s.imu_offset_in_P_m = sensors.Vec3("imu_offset_m");
   s.has_orientation = sensors.Bool("has_orientation");
   s.orientation_noise_std_rad = sensors.NonNegativeDouble("orientation_noise_std_rad");
-  const int seed = sensors.Int("seed");
-  if (seed < 0) sensors.Fail("seed", "must not be negative");
-  s.seed = static_cast<unsigned>(seed);
+  s.seed = static_cast<unsigned>(sensors.IntInRange("seed", 0, INT_MAX, "must not be negative"));
   return s;
 }
 

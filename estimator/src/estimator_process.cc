@@ -2,19 +2,18 @@
 
 #include <spdlog/spdlog.h>
 
+#include <tuple>
+
 #include "stewart/common/check.h"
 
 namespace stewart {
 
 StateSample StateFromEstimate(const Estimate& estimate, int64_t seq) {
   StateSample s;
-  s.utime = estimate.utime;
+  s.utime = s.sample_utime = estimate.utime;
   s.seq = seq;
-  s.sample_utime = estimate.utime;
-  s.q = estimate.q;
-  s.qd = estimate.qd;
-  s.q_std = estimate.q_std;
-  s.qd_std = estimate.qd_std;
+  std::tie(s.q, s.qd, s.q_std, s.qd_std) =
+      std::tie(estimate.q, estimate.qd, estimate.q_std, estimate.qd_std);
   s.status = estimate.initializing ? kStateInitializing : kStateValid;
   if (estimate.diverged) s.status |= kStateDiverged;
   return s;

@@ -62,12 +62,15 @@ void MakeRaw(int fd, speed_t speed, const std::string& what) {
 
 }  // namespace
 
-FdStreamTransport::FdStreamTransport(int fd, std::string description)
+FdTransport::FdTransport(int fd, std::string description)
     : fd_(fd), description_(std::move(description)) {}
 
-FdStreamTransport::~FdStreamTransport() {
+FdTransport::~FdTransport() {
   if (fd_ >= 0) close(fd_);
 }
+
+FdStreamTransport::FdStreamTransport(int fd, std::string description)
+    : FdTransport(fd, std::move(description)) {}
 
 bool FdStreamTransport::Send(const uint8_t* data, std::size_t size) {
   std::size_t sent = 0;

@@ -26,9 +26,9 @@ sockaddr_in Address(const std::string& host, int port, const std::string& what) 
 }  // namespace
 
 UdpTransport::UdpTransport(const std::string& bind_host, int bind_port,
-                           const std::string& peer_host, int peer_port) {
-  description_ = "udp " + bind_host + ":" + std::to_string(bind_port) + " <-> " + peer_host + ":" +
-                 std::to_string(peer_port);
+                           const std::string& peer_host, int peer_port)
+    : FdTransport(-1, "udp " + bind_host + ":" + std::to_string(bind_port) + " <-> " + peer_host +
+                          ":" + std::to_string(peer_port)) {
   const sockaddr_in local = Address(bind_host, bind_port, "bind host");
   const sockaddr_in peer = Address(peer_host, peer_port, "peer host");
   peer_addr_ = peer.sin_addr.s_addr;
@@ -36,15 +36,10 @@ UdpTransport::UdpTransport(const std::string& bind_host, int bind_port,
   fd_ = socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
   if (fd_ < 0) throw std::runtime_error("socket(): " + std::string(std::strerror(errno)));
   if (bind(fd_, reinterpret_cast<const sockaddr*>(&local), sizeof(local)) != 0) {
-    const std::string err = std::strerror(errno);
-    close(fd_);
+    const std::string err = std::strerror(errno);  // FdTransport closes fd_
     throw std::runtime_error("cannot bind " + bind_host + ":" + std::to_string(bind_port) + ": " +
                              err);
   }
-}
-
-UdpTransport::~UdpTransport() {
-  if (fd_ >= 0) close(fd_);
 }
 
 bool UdpTransport::Send(const uint8_t* data, std::size_t size) {

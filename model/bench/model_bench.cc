@@ -1,17 +1,12 @@
 // Benchmarks of the model terms that sit on every process's hot path.
 #include <benchmark/benchmark.h>
 
-#include "stewart/config/config_loader.h"
+#include "stewart/config/default_config.h"
 #include "stewart/model/dynamics.h"
 #include "stewart/model/kinematics.h"
 
 namespace stewart {
 namespace {
-
-const StackConfig& Config() {
-  static const StackConfig config = LoadStackConfig(DefaultConfigPath());
-  return config;
-}
 
 Vector6d TestPose() {
   Vector6d q;
@@ -25,24 +20,29 @@ Vector6d TestVelocity() {
   return qd;
 }
 
+/// M, C qd, G and H at the test state.
+DynamicsTerms TestTerms() {
+  return EvaluateDynamics(DefaultStackConfig().platform, TestPose(), TestVelocity());
+}
+
 void BM_InverseKinematics(benchmark::State& state) {
-  const PlatformParams& p = Config().platform;
+  const PlatformParams& p = DefaultStackConfig().platform;
   const Vector6d q = TestPose();
   for (auto _ : state) benchmark::DoNotOptimize(InverseKinematics(p, q));
 }
 BENCHMARK(BM_InverseKinematics);
 
 void BM_ForwardKinematics(benchmark::State& state) {
-  const PlatformParams& p = Config().platform;
+  const PlatformParams& p = DefaultStackConfig().platform;
   const Vector6d q = TestPose();
   const Vector6d lengths = InverseKinematics(p, q);
-  const Vector6d guess = Config().home_pose;  // a cold start, 4-5 Newton steps
+  const Vector6d guess = DefaultStackConfig().home_pose;  // a cold start, 4-5 Newton steps
   for (auto _ : state) benchmark::DoNotOptimize(ForwardKinematics(p, lengths, guess));
 }
 BENCHMARK(BM_ForwardKinematics);
 
 void BM_ForwardKinematicsWarm(benchmark::State& state) {
-  const PlatformParams& p = Config().platform;
+  const PlatformParams& p = DefaultStackConfig().platform;
   const Vector6d q = TestPose();
   const Vector6d lengths = InverseKinematics(p, q);
   Vector6d guess = q;
@@ -53,7 +53,7 @@ BENCHMARK(BM_ForwardKinematicsWarm);
 
 // M, C qd, G and H: the terms every process needs at each tick.
 void BM_DynamicsTerms(benchmark::State& state) {
-  const PlatformParams& p = Config().platform;
+  const PlatformParams& p = DefaultStackConfig().platform;
   const Vector6d q = TestPose();
   const Vector6d qd = TestVelocity();
   DynamicsTerms terms;
@@ -65,16 +65,14 @@ void BM_DynamicsTerms(benchmark::State& state) {
 BENCHMARK(BM_DynamicsTerms);
 
 void BM_ForwardDynamics(benchmark::State& state) {
-  const PlatformParams& p = Config().platform;
-  const DynamicsTerms terms = EvaluateDynamics(p, TestPose(), TestVelocity());
+  const DynamicsTerms terms = TestTerms();
   Vector6d force = Vector6d::Constant(3.0);
   for (auto _ : state) benchmark::DoNotOptimize(ForwardDynamics(terms, force));
 }
 BENCHMARK(BM_ForwardDynamics);
 
 void BM_InverseDynamics(benchmark::State& state) {
-  const PlatformParams& p = Config().platform;
-  const DynamicsTerms terms = EvaluateDynamics(p, TestPose(), TestVelocity());
+  const DynamicsTerms terms = TestTerms();
   Vector6d qdd = Vector6d::Constant(0.1);
   for (auto _ : state) benchmark::DoNotOptimize(InverseDynamics(terms, qdd));
 }

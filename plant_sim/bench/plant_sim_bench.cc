@@ -6,7 +6,7 @@
 
 #include <cmath>
 
-#include "stewart/config/config_loader.h"
+#include "stewart/config/default_config.h"
 #include "stewart/model/kinematics.h"
 #include "stewart/plant_sim/plant.h"
 #include "stewart/plant_sim/sensor_model.h"
@@ -14,13 +14,8 @@
 namespace stewart {
 namespace {
 
-const StackConfig& Config() {
-  static const StackConfig config = LoadStackConfig(DefaultConfigPath());
-  return config;
-}
-
 void RunTicks(benchmark::State& state, OdeMethod method, int erk_order = 5) {
-  const StackConfig& c = Config();
+  const StackConfig& c = DefaultStackConfig();
   const PlantModel model{c.platform, c.actuators};
   OdeOptions o;
   o.method = method;
@@ -66,7 +61,7 @@ BENCHMARK(BM_PlantTick_CvodeAdams);
 
 // Tick plus the sensor sample the process publishes with it.
 void BM_PlantTickWithSensors(benchmark::State& state) {
-  const StackConfig& c = Config();
+  const StackConfig& c = DefaultStackConfig();
   Plant plant(PlantModel{c.platform, c.actuators}, OdeOptions{});
   SensorModel sensors(c.sensors, c.actuators, c.platform.gravity_mps2);
   const Vector6d q0 = c.plant_sim.initial_pose;
@@ -95,7 +90,7 @@ BENCHMARK(BM_PlantTickWithSensors);
 
 // The cost units: one model evaluation and one ODE right-hand side.
 void BM_EvaluateDynamics(benchmark::State& state) {
-  const StackConfig& c = Config();
+  const StackConfig& c = DefaultStackConfig();
   Vector6d qd = Vector6d::Constant(0.01);
   DynamicsTerms terms;
   for (auto _ : state) {
@@ -106,7 +101,7 @@ void BM_EvaluateDynamics(benchmark::State& state) {
 BENCHMARK(BM_EvaluateDynamics);
 
 void BM_PlantDerivative(benchmark::State& state) {
-  const StackConfig& c = Config();
+  const StackConfig& c = DefaultStackConfig();
   const PlantModel model{c.platform, c.actuators};
   PlantStateVector x = PlantStateVector::Zero();
   x.segment<6>(0) = c.plant_sim.initial_pose;

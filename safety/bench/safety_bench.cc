@@ -4,7 +4,7 @@
 #include <random>
 #include <vector>
 
-#include "stewart/config/config_loader.h"
+#include "stewart/config/default_config.h"
 #include "stewart/safety/clp_reference_qp.h"
 #include "stewart/safety/safety_filter.h"
 #ifdef STEWART_HAVE_ALGLIB
@@ -13,11 +13,6 @@
 
 namespace stewart::safety {
 namespace {
-
-const StackConfig& Config() {
-  static const StackConfig config = LoadStackConfig(DefaultConfigPath());
-  return config;
-}
 
 // A fixed set of states around home with nominal forces that make the filter
 // act often (every case occurs), cycled through by every benchmark.
@@ -32,10 +27,10 @@ const std::vector<Sample>& Samples() {
     std::normal_distribution<double> n;
     for (int i = 0; i < 256; ++i) {
       Sample x;
-      x.q = Config().home_pose;
+      x.q = DefaultStackConfig().home_pose;
       for (int j = 0; j < 3; ++j) x.q(j) += 0.03 * n(rng);
       for (int j = 0; j < 6; ++j) x.qd(j) = 0.008 * n(rng);
-      x.terms = EvaluateDynamics(Config().platform, x.q, x.qd);
+      x.terms = EvaluateDynamics(DefaultStackConfig().platform, x.q, x.qd);
       Vector6d qdd;
       for (int j = 0; j < 6; ++j) qdd(j) = 2.0 * n(rng);
       x.f_des = InverseDynamics(x.terms, qdd);
@@ -48,7 +43,7 @@ const std::vector<Sample>& Samples() {
 
 // The filter on `safety` (the platform and actuators of the config file).
 void RunCore(benchmark::State& state, const SafetyConfig& safety) {
-  SafetyFilter filter(Config().platform, safety, Config().actuators);
+  SafetyFilter filter(DefaultStackConfig().platform, safety, DefaultStackConfig().actuators);
   SafetyDiagnostics d;
   size_t i = 0;
   for (auto _ : state) {
@@ -59,7 +54,8 @@ void RunCore(benchmark::State& state, const SafetyConfig& safety) {
 
 void RunFullStep(benchmark::State& state, const SafetyConfig& safety,
                  ReferenceQpSolver* reference = nullptr) {
-  SafetyFilter filter(Config().platform, safety, Config().actuators, reference);
+  SafetyFilter filter(DefaultStackConfig().platform, safety, DefaultStackConfig().actuators,
+                      reference);
   SafetyDiagnostics d;
   size_t i = 0;
   for (auto _ : state) {
@@ -69,13 +65,14 @@ void RunFullStep(benchmark::State& state, const SafetyConfig& safety,
 }
 
 // (a) the closed form given the model terms.
-void BM_ClosedFormCore(benchmark::State& state) { RunCore(state, Config().safety); }
+void BM_ClosedFormCore(benchmark::State& state) { RunCore(state, DefaultStackConfig().safety); }
 BENCHMARK(BM_ClosedFormCore);
 
 // (a) on the states where a constraint acts only (about half of the set): the
 // only steps that solve with H, so the per-step worst case of the closed form.
 void BM_ClosedFormCoreActiveOnly(benchmark::State& state) {
-  SafetyFilter filter(Config().platform, Config().safety, Config().actuators);
+  SafetyFilter filter(DefaultStackConfig().platform, DefaultStackConfig().safety,
+                      DefaultStackConfig().actuators);
   std::vector<const Sample*> active;
   SafetyDiagnostics d;
   for (const Sample& s : Samples()) {
@@ -92,19 +89,21 @@ void BM_ClosedFormCoreActiveOnly(benchmark::State& state) {
 BENCHMARK(BM_ClosedFormCoreActiveOnly);
 
 // (b) the full step including M, C qd, G, H.
-void BM_ClosedFormFullStep(benchmark::State& state) { RunFullStep(state, Config().safety); }
+void BM_ClosedFormFullStep(benchmark::State& state) {
+  RunFullStep(state, DefaultStackConfig().safety);
+}
 BENCHMARK(BM_ClosedFormFullStep);
 
 // (a) with the paper's force metric (no metric map per step).
 void BM_ClosedFormCoreForceMetric(benchmark::State& state) {
-  SafetyConfig s = Config().safety;
+  SafetyConfig s = DefaultStackConfig().safety;
   s.correction_metric = CorrectionMetric::kForce;
   RunCore(state, s);
 }
 BENCHMARK(BM_ClosedFormCoreForceMetric);
 
 void BM_PaperRuleCore(benchmark::State& state) {
-  SafetyConfig s = Config().safety;
+  SafetyConfig s = DefaultStackConfig().safety;
   s.variant = SafetyVariant::kPaperRule;
   RunCore(state, s);
 }
@@ -114,7 +113,7 @@ BENCHMARK(BM_PaperRuleCore);
 template <typename Solver>
 void BM_QpReferenceFullStep(benchmark::State& state) {
   Solver solver;
-  SafetyConfig s = Config().safety;
+  SafetyConfig s = DefaultStackConfig().safety;
   s.variant = SafetyVariant::kQpReference;
   RunFullStep(state, s, &solver);
 }
@@ -125,7 +124,7 @@ BENCHMARK_TEMPLATE(BM_QpReferenceFullStep, AlglibReferenceQp);
 
 // (d) the force-limited variant (exact dual active set), full step.
 void BM_ForceLimitedFullStep(benchmark::State& state) {
-  SafetyConfig s = Config().safety;
+  SafetyConfig s = DefaultStackConfig().safety;
   s.force_limits_enabled = true;
   RunFullStep(state, s);
 }
@@ -134,7 +133,7 @@ BENCHMARK(BM_ForceLimitedFullStep);
 // The un-composed QP (every barrier its own row, dual active set), full
 // step, unlimited and force-limited: what dropping the LSE costs per step.
 void BM_UncomposedFullStep(benchmark::State& state) {
-  SafetyConfig s = Config().safety;
+  SafetyConfig s = DefaultStackConfig().safety;
   s.variant = SafetyVariant::kUncomposed;
   s.force_limits_enabled = state.range(0) != 0;
   RunFullStep(state, s);
@@ -146,7 +145,7 @@ void BM_ModelTermsOnly(benchmark::State& state) {
   size_t i = 0;
   for (auto _ : state) {
     const Sample& x = Samples()[i++ & 255];
-    EvaluateDynamics(Config().platform, x.q, x.qd, &t);
+    EvaluateDynamics(DefaultStackConfig().platform, x.q, x.qd, &t);
     benchmark::DoNotOptimize(t);
   }
 }

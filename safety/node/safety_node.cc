@@ -31,11 +31,7 @@ void SafetyNode::OnNominal(const lcm::ReceiveBuffer*, const std::string&,
 void SafetyNode::Publish(const safety::SafetyOutput& out) {
   ToMessage(out.command, &command_);
   lcm_->publish(config_.lcm.channels.command_safe, &command_);
-  safety::FillDiagnosticsMessage(process_.filter(), *out.diagnostics, &diagnostics_msg_);
-  diagnostics_msg_.utime = out.command.utime;
-  diagnostics_msg_.seq = out.command.seq;
-  diagnostics_msg_.sample_utime = out.command.sample_utime;
-  diagnostics_msg_.fallback_reason |= out.fallback_reason;
+  safety::FillDiagnosticsMessage(process_.filter(), out, &diagnostics_msg_);
   lcm_->publish(config_.lcm.channels.safety_diagnostics, &diagnostics_msg_);
 }
 

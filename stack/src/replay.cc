@@ -47,12 +47,84 @@ bool IsFallback(int32_t flags) {
   return (flags & (force_command_t::FLAG_FALLBACK | force_command_t::FLAG_STALE_INPUT)) != 0;
 }
 
-
 std::array<double, 6> ToStdArray(const Vector6d& v) {
   std::array<double, 6> a{};
   for (int i = 0; i < 6; ++i) a[static_cast<size_t>(i)] = v(i);
   return a;
 }
+
+/// A message's seq and utime.
+using Stamp = std::pair<int64_t, int64_t>;
+
+/// Decodes `event` onto the end of `messages`; its stamp, or nothing (and
+/// `messages` unchanged) when it does not decode.
+template <typename Msg>
+std::optional<Stamp> Append(const lcm::LogEvent& event, std::vector<Msg>* messages) {
+  Msg& msg = messages->emplace_back();
+  if (Decode(event, &msg)) return Stamp{msg.seq, msg.utime};
+  messages->pop_back();
+  return std::nullopt;
+}
+
+/// `f(&messages)` with the vector of `channel`'s messages (every channel but
+/// kSafetyDiagnostics, whose RecordedLog keeps only RecordedDiagnostics).
+template <typename F>
+std::optional<Stamp> WithMessages(RecordedLog* log, Channel channel, F f) {
+  switch (channel) {
+    case Channel::kSensors:
+      return f(&log->sensors);
+    case Channel::kStateEstimate:
+      return f(&log->estimates);
+    case Channel::kStateTruth:
+      return f(&log->truth);
+    case Channel::kCommandNominal:
+      return f(&log->nominal);
+    case Channel::kCommandSafe:
+      return f(&log->safe);
+    case Channel::kSafetyDiagnostics:
+      break;
+  }
+  return std::nullopt;
+}
+
+/// Pairs the outputs a replay publishes with the recorded messages of the
+/// same sample_utime, counting both sides into an OutputPairing.
+template <typename Msg>
+class Pairing {
+ public:
+  Pairing(const std::vector<Msg>& recorded, OutputPairing* counts)
+      : recorded_(recorded), index_(IndexBySample(recorded)), counts_(counts) {
+    counts_->recorded = static_cast<long>(recorded.size());
+  }
+
+  /// The recorded message of `sample_utime`, or nullptr.
+  const Msg* Recorded(int64_t sample_utime) const {
+    const int* index = Find(index_, sample_utime);
+    return index == nullptr ? nullptr : &recorded_[static_cast<size_t>(*index)];
+  }
+  /// A replayed output of `sample_utime`: its recorded counterpart, or nullptr.
+  const Msg* Match(int64_t sample_utime) {
+    ++counts_->replayed;
+    replayed_.insert(sample_utime);
+    const Msg* recorded = Recorded(sample_utime);
+    if (recorded == nullptr) ++counts_->without_recorded;
+    return recorded;
+  }
+  /// Whether the replay published an output of `sample_utime`.
+  bool Replayed(int64_t sample_utime) const { return replayed_.count(sample_utime) != 0; }
+  /// After the replay: counts the recorded messages no output matched.
+  void Finish() {
+    for (const Msg& recorded : recorded_) {
+      if (!Replayed(recorded.sample_utime)) ++counts_->recorded_without_replay;
+    }
+  }
+
+ private:
+  const std::vector<Msg>& recorded_;
+  const std::unordered_map<int64_t, int> index_;
+  OutputPairing* counts_;
+  std::unordered_set<int64_t> replayed_;
+};
 
 }  // namespace
 
@@ -93,66 +165,27 @@ RecordedLog ReadLog(const std::string& path, const ChannelNames& channels) {
     ++log.events;
     const auto route = routes.find(event->channel);
     if (route == routes.end()) continue;
-    bool ok = false;
+    const Channel channel = route->second;
     int index = 0;
-    switch (route->second) {
-      case Channel::kSensors:
-        index = static_cast<int>(log.sensors.size());
-        ok = Decode(*event, &log.sensors.emplace_back());
-        if (!ok) log.sensors.pop_back();
-        break;
-      case Channel::kStateEstimate:
-        index = static_cast<int>(log.estimates.size());
-        ok = Decode(*event, &log.estimates.emplace_back());
-        if (!ok) log.estimates.pop_back();
-        break;
-      case Channel::kStateTruth:
-        index = static_cast<int>(log.truth.size());
-        ok = Decode(*event, &log.truth.emplace_back());
-        if (!ok) log.truth.pop_back();
-        break;
-      case Channel::kCommandNominal:
-        index = static_cast<int>(log.nominal.size());
-        ok = Decode(*event, &log.nominal.emplace_back());
-        if (!ok) log.nominal.pop_back();
-        break;
-      case Channel::kCommandSafe:
-        index = static_cast<int>(log.safe.size());
-        ok = Decode(*event, &log.safe.emplace_back());
-        if (!ok) log.safe.pop_back();
-        break;
-      case Channel::kSafetyDiagnostics:
-        index = static_cast<int>(log.diagnostics.size());
-        ok = Decode(*event, &diagnostics);
-        if (ok) {
-          log.diagnostics.push_back({diagnostics.sample_utime, diagnostics.compute_ns,
-                                     diagnostics.variant, diagnostics.force_limits != 0});
-        }
-        break;
-    }
-    if (ok) {
-      log.order.emplace_back(route->second, index);
-      const size_t i = static_cast<size_t>(index);
-      switch (route->second) {
-        case Channel::kSensors:
-          track(route->second, log.sensors[i].seq, log.sensors[i].utime);
-          break;
-        case Channel::kStateEstimate:
-          track(route->second, log.estimates[i].seq, log.estimates[i].utime);
-          break;
-        case Channel::kStateTruth:
-          track(route->second, log.truth[i].seq, log.truth[i].utime);
-          break;
-        case Channel::kCommandNominal:
-          track(route->second, log.nominal[i].seq, log.nominal[i].utime);
-          break;
-        case Channel::kCommandSafe:
-          track(route->second, log.safe[i].seq, log.safe[i].utime);
-          break;
-        case Channel::kSafetyDiagnostics:
-          track(route->second, diagnostics.seq, diagnostics.utime);
-          break;
+    std::optional<Stamp> stamp;
+    if (channel == Channel::kSafetyDiagnostics) {
+      index = static_cast<int>(log.diagnostics.size());
+      if (Decode(*event, &diagnostics)) {
+        log.diagnostics.push_back({diagnostics.sample_utime, diagnostics.compute_ns,
+                                   diagnostics.variant, diagnostics.force_limits != 0,
+                                   diagnostics.active_case, diagnostics.fallback_reason,
+                                   diagnostics.flags});
+        stamp = Stamp{diagnostics.seq, diagnostics.utime};
       }
+    } else {
+      stamp = WithMessages(&log, channel, [&](auto* messages) {
+        index = static_cast<int>(messages->size());
+        return Append(*event, messages);
+      });
+    }
+    if (stamp) {
+      log.order.emplace_back(channel, index);
+      track(channel, stamp->first, stamp->second);
     } else {
       ++log.undecodable[event->channel];
     }
@@ -205,8 +238,7 @@ TimeStats ComputeTimeStats(std::vector<int64_t> ns) {
 SafetyReplayResult ReplaySafety(const StackConfig& config, const RecordedLog& log,
                                 safety::ReferenceQpSolver* reference) {
   SafetyReplayResult r;
-  // The process's own class: its Filter and Fallback make the replayed
-  // commands, so they are built exactly as the live node built them.
+  // The process's own class, built exactly as the live node built it.
   HealthCounters counters("safety replay");
   safety::SafetyProcess process(config.platform, config.safety, config.actuators, reference,
                                 &counters);
@@ -235,101 +267,108 @@ SafetyReplayResult ReplaySafety(const StackConfig& config, const RecordedLog& lo
   }
 
   const auto state_of = IndexBySample(log.estimates);
-  const auto safe_of = IndexBySample(log.safe);
+  Pairing<force_command_t> safe(log.safe, &r.commands);
   std::unordered_map<int64_t, int> diagnostics_of;
   for (size_t i = 0; i < log.diagnostics.size(); ++i) {
     diagnostics_of.emplace(log.diagnostics[i].sample_utime, static_cast<int>(i));
   }
-
-  // Every recorded nominal command with the estimate of the same
-  // sample_utime, as SafetyProcess::OnNominal pairs them.
-  std::vector<int64_t> replayed_ns, recorded_ns;
-  std::unordered_map<int64_t, size_t> step_of;
-  r.steps.reserve(log.nominal.size());
+  r.nominal_commands = static_cast<long>(log.nominal.size());
   for (const force_command_t& nominal : log.nominal) {
-    ++r.nominal_commands;
-    const int* state_index = Find(state_of, nominal.sample_utime);
-    if (state_index == nullptr) {
-      ++r.without_state;
-      continue;
-    }
-    const state_t& state = log.estimates[static_cast<size_t>(*state_index)];
-    const safety::SafetyOutput out = process.Filter(FromMessage(state), FromMessage(nominal));
+    if (Find(state_of, nominal.sample_utime) == nullptr) ++r.without_state;
+    const force_command_t* recorded = safe.Recorded(nominal.sample_utime);
+    if (recorded != nullptr && IsFallback(recorded->flags)) ++r.answered_by_fallback;
+  }
+
+  // One safe command the process published, against the recorded one; its
+  // diagnostics (case, fallback reason, flags) against the recorded ones.
+  std::vector<int64_t> replayed_ns, recorded_ns;
+  safety_diagnostics_t replayed_diagnostics;  // reused: keeps its capacities
+  auto compare = [&](const safety::SafetyOutput& out, bool watchdog_in_gap) {
     SafetyStep step;
-    step.sample_utime = nominal.sample_utime;
+    step.sample_utime = out.command.sample_utime;
     step.f_replayed = ToStdArray(out.command.force_n);
     step.replayed_flags = out.command.flags;
     step.replayed_case = static_cast<int8_t>(out.diagnostics->filter_case);
     step.replayed_ns = out.diagnostics->compute_ns;
     ++r.replayed_cases[static_cast<size_t>(step.replayed_case)];
-    const int* safe_index = Find(safe_of, nominal.sample_utime);
-    if (safe_index == nullptr) {
-      ++r.without_recorded_command;
+    const force_command_t* recorded = safe.Match(step.sample_utime);
+    if (recorded == nullptr) {
       step.kind = SafetyStepKind::kUnrecorded;
-    } else {
-      const force_command_t& recorded = log.safe[static_cast<size_t>(*safe_index)];
-      std::copy(std::begin(recorded.force_n), std::end(recorded.force_n), step.f_recorded.begin());
-      step.recorded_flags = recorded.flags;
-      if (const int* diag_index = Find(diagnostics_of, nominal.sample_utime)) {
-        step.recorded_ns = log.diagnostics[static_cast<size_t>(*diag_index)].compute_ns;
-      }
-      if (IsFallback(recorded.flags)) {
-        ++r.answered_by_fallback;
-        step.kind = SafetyStepKind::kFallback;
+      r.steps.push_back(step);
+      return;
+    }
+    std::copy(std::begin(recorded->force_n), std::end(recorded->force_n), step.f_recorded.begin());
+    step.recorded_flags = recorded->flags;
+    bool diagnostics_equal = true;
+    if (const int* diag_index = Find(diagnostics_of, step.sample_utime)) {
+      const RecordedDiagnostics& d = log.diagnostics[static_cast<size_t>(*diag_index)];
+      step.recorded_ns = d.compute_ns;
+      safety::FillDiagnosticsMessage(process.filter(), out, &replayed_diagnostics);
+      diagnostics_equal = d.active_case == replayed_diagnostics.active_case &&
+                          d.fallback_reason == replayed_diagnostics.fallback_reason &&
+                          d.flags == replayed_diagnostics.flags;
+      if (!diagnostics_equal && !watchdog_in_gap) ++r.diagnostics_differ;
+    }
+    const bool flags_equal = recorded->flags == step.replayed_flags;
+    const bool others_equal = flags_equal && diagnostics_equal;
+    if (watchdog_in_gap) {
+      // The live watchdog had nominal commands the log lacks.
+      step.kind = SafetyStepKind::kLogGap;
+      ++r.log_gap;
+    } else if (IsFallback(recorded->flags)) {
+      step.kind = SafetyStepKind::kFallback;
+      if (out.fallback_reason == kCommandStaleInput) {
+        ++r.fallback_stale_input;
+      } else if (out.fallback_reason == kCommandInvalidInput) {
+        ++r.fallback_invalid_state;
       } else {
-        step.kind = SafetyStepKind::kCompared;
-        const bool flags_equal = recorded.flags == step.replayed_flags;
-        if (!flags_equal) ++r.flags_differ;
-        r.filter.Add(step.sample_utime, step.f_replayed.data(), recorded.force_n, 6, flags_equal);
-        replayed_ns.push_back(step.replayed_ns);
-        if (step.recorded_ns >= 0) recorded_ns.push_back(step.recorded_ns);
+        ++r.fallback_by_filter;
+      }
+      r.fallback.Add(step.sample_utime, step.f_replayed.data(), recorded->force_n, 6, others_equal);
+    } else {
+      step.kind = SafetyStepKind::kCompared;
+      if (!flags_equal) ++r.flags_differ;
+      r.filter.Add(step.sample_utime, step.f_replayed.data(), recorded->force_n, 6, others_equal);
+      replayed_ns.push_back(step.replayed_ns);
+      if (step.recorded_ns >= 0) recorded_ns.push_back(step.recorded_ns);
+    }
+    r.steps.push_back(step);
+  };
+
+  // SafetyProcess::OnState / OnNominal in the order the log received them.
+  // Until the next recorded nominal command, the log lacks nominal commands
+  // the live process had when that one follows a gap in seq (or the log's
+  // first is not seq 0): a watchdog fallback (OnState, stale input) then is
+  // the log's, not the process's.
+  size_t nominal_next = 0;
+  auto lacking_nominal = [&log, &nominal_next] {
+    if (nominal_next >= log.nominal.size()) return false;
+    const int64_t expected = nominal_next == 0 ? 0 : log.nominal[nominal_next - 1].seq + 1;
+    return log.nominal[nominal_next].seq > expected;
+  };
+  r.steps.reserve(log.nominal.size());
+  for (const auto& [channel, index] : log.order) {
+    safety::SafetyOutput out;
+    if (channel == Channel::kStateEstimate) {
+      ++r.states;
+      if (process.OnState(FromMessage(log.estimates[static_cast<size_t>(index)]), &out)) {
+        compare(out, out.fallback_reason == kCommandStaleInput && lacking_nominal());
+      }
+    } else if (channel == Channel::kCommandNominal) {
+      ++nominal_next;
+      if (process.OnNominal(FromMessage(log.nominal[static_cast<size_t>(index)]), &out)) {
+        compare(out, false);
       }
     }
-    step_of.emplace(step.sample_utime, r.steps.size());
-    r.steps.push_back(step);
   }
+  safe.Finish();
   r.replayed_ns = ComputeTimeStats(std::move(replayed_ns));
   r.recorded_ns = ComputeTimeStats(std::move(recorded_ns));
-
-  // Every recorded fallback, replayed along the path the node took
-  // (SafetyProcess::Fallback, or the filter's own last resort).
   for (const force_command_t& recorded : log.safe) {
-    if (!IsFallback(recorded.flags)) continue;
-    ++r.fallback_commands;
-    const int* state_index = Find(state_of, recorded.sample_utime);
-    if (state_index == nullptr) {
-      ++r.fallback_without_input;
-      continue;
-    }
-    const state_t& state = log.estimates[static_cast<size_t>(*state_index)];
-    std::array<double, 6> f{};
-    int32_t flags = 0;
-    int32_t node_reason = 0;
-    if (recorded.flags & kCommandStaleInput) {
-      ++r.fallback_stale_input;
-      node_reason = kCommandStaleInput;
-    } else if (!StateUsable(state.status)) {
-      ++r.fallback_invalid_state;
-      node_reason = kCommandInvalidInput;
-    } else {
-      ++r.fallback_by_filter;
-    }
-    if (node_reason != 0) {
-      const safety::SafetyOutput out = process.Fallback(FromMessage(state), node_reason);
-      f = ToStdArray(out.command.force_n);
-      flags = out.command.flags;
-    } else {
-      const size_t* step_index = Find(step_of, recorded.sample_utime);
-      if (step_index == nullptr) {
-        ++r.fallback_without_input;
-        continue;
-      }
-      const SafetyStep& step = r.steps[*step_index];
-      f = step.f_replayed;
-      flags = step.replayed_flags;
-    }
-    r.fallback.Add(recorded.sample_utime, f.data(), recorded.force_n, 6, flags == recorded.flags);
+    if (IsFallback(recorded.flags)) ++r.fallback_commands;
   }
+  r.fallback_without_input = r.fallback_commands - r.fallback_stale_input -
+                             r.fallback_invalid_state - r.fallback_by_filter;
   return r;
 }
 
@@ -365,8 +404,7 @@ ControllerReplayResult ReplayController(const StackConfig& config, const Scenari
   HealthCounters counters("controller replay");
   ControllerProcess process(config.platform, config.controller, config.home_pose, scenario,
                             &counters);
-  const auto recorded_of = IndexBySample(log.nominal);
-  std::unordered_set<int64_t> replayed_samples;
+  Pairing<force_command_t> recorded_commands(log.nominal, &r.commands);
   const std::optional<int64_t> origin = ControllerTimeOrigin(log, &r.time_origin_inferred);
   r.time_origin_utime = origin.value_or(-1);
   bool started = false;
@@ -392,24 +430,15 @@ ControllerReplayResult ReplayController(const StackConfig& config, const Scenari
       ++r.step_rejected;
       continue;
     }
-    ++r.replayed;
-    replayed_samples.insert(state.sample_utime);
     force_command_t command{};
     ToMessage(out.command, &command);
-    const int* index = Find(recorded_of, state.sample_utime);
-    if (index == nullptr) {
-      ++r.without_recorded_command;
-      continue;
-    }
-    const force_command_t& recorded = log.nominal[static_cast<size_t>(*index)];
-    const bool flags_equal = recorded.flags == command.flags;
+    const force_command_t* recorded = recorded_commands.Match(state.sample_utime);
+    if (recorded == nullptr) continue;
+    const bool flags_equal = recorded->flags == command.flags;
     if (!flags_equal) ++r.flags_differ;
-    r.nominal.Add(state.sample_utime, command.force_n, recorded.force_n, 6, flags_equal);
+    r.nominal.Add(state.sample_utime, command.force_n, recorded->force_n, 6, flags_equal);
   }
-  r.recorded_commands = static_cast<long>(log.nominal.size());
-  for (const force_command_t& recorded : log.nominal) {
-    if (replayed_samples.count(recorded.sample_utime) == 0) ++r.recorded_without_replay;
-  }
+  recorded_commands.Finish();
   return r;
 }
 
@@ -431,6 +460,27 @@ bool EstimateFinite(const state_t& s) {
 
 }  // namespace
 
+void EstimateDiff::Add(const state_t& replayed, const state_t& recorded) {
+  const auto a = StateValues(replayed);
+  const auto b = StateValues(recorded);
+  values.Add(replayed.sample_utime, a.data(), b.data(), static_cast<int>(a.size()),
+             recorded.status == replayed.status && recorded.utime == replayed.utime);
+  // In sigmas of the difference of two estimates: hypot(std_a, std_b).
+  auto sigmas = [](double diff, double std_a, double std_b) {
+    const double std = std::hypot(std_a, std_b);
+    return std > 0.0 ? diff / std : 0.0;
+  };
+  for (int i = 0; i < 6; ++i) {
+    const double dq = std::fabs(replayed.q[i] - recorded.q[i]);
+    const double dqd = std::fabs(replayed.qd[i] - recorded.qd[i]);
+    max_abs_diff_q = std::fmax(max_abs_diff_q, dq);
+    max_abs_diff_qd = std::fmax(max_abs_diff_qd, dqd);
+    max_diff_sigma =
+        std::fmax(max_diff_sigma, std::fmax(sigmas(dq, recorded.q_std[i], replayed.q_std[i]),
+                                            sigmas(dqd, recorded.qd_std[i], replayed.qd_std[i])));
+  }
+}
+
 EstimatorReplayResult ReplayEstimator(const StackConfig& config, const RecordedLog& log) {
   EstimatorReplayResult r;
   r.perfect_state = config.estimator.perfect_state;
@@ -446,8 +496,7 @@ EstimatorReplayResult ReplayEstimator(const StackConfig& config, const RecordedL
     }
     r.inputs_missing += gaps.missing;
   }
-  const auto recorded_of = IndexBySample(log.estimates);
-  std::unordered_set<int64_t> replayed_samples;
+  Pairing<state_t> recorded_estimates(log.estimates, &r.estimates);
   HealthCounters counters("estimator replay");
   EstimatorProcess process(config.platform, config.actuators, config.sensors, config.estimator,
                            config.home_pose, &counters);
@@ -456,40 +505,13 @@ EstimatorReplayResult ReplayEstimator(const StackConfig& config, const RecordedL
     ToMessage(sample, &replayed);
     // EstimatorNode::Publish drops non-finite estimates.
     if (!EstimateFinite(replayed)) return;
-    ++r.replayed;
-    replayed_samples.insert(replayed.sample_utime);
-    const int* index = Find(recorded_of, replayed.sample_utime);
-    if (index == nullptr) {
-      ++r.without_recorded_estimate;
-      return;
-    }
-    const state_t& recorded = log.estimates[static_cast<size_t>(*index)];
+    const state_t* match = recorded_estimates.Match(replayed.sample_utime);
+    if (match == nullptr) return;
+    const state_t& recorded = *match;
     const bool intact =
         r.inputs_missing == 0 || replayed.sample_utime <= r.inputs_intact_until_utime;
-    const bool status_equal = recorded.status == replayed.status;
-    if (!status_equal && intact) ++r.status_differ;
-    const auto a = StateValues(replayed);
-    const auto b = StateValues(recorded);
-    (intact ? r.state : r.after_gap)
-        .Add(replayed.sample_utime, a.data(), b.data(), static_cast<int>(a.size()),
-             status_equal && recorded.utime == replayed.utime);
-    double& max_q = intact ? r.max_abs_diff_q : r.max_abs_diff_q_after_gap;
-    double& max_qd = intact ? r.max_abs_diff_qd : r.max_abs_diff_qd_after_gap;
-    double& max_sigma = intact ? r.max_diff_sigma : r.max_diff_sigma_after_gap;
-    // In sigmas of the difference of two estimates: hypot(std_a, std_b).
-    auto sigmas = [](double diff, double std_a, double std_b) {
-      const double std = std::hypot(std_a, std_b);
-      return std > 0.0 ? diff / std : 0.0;
-    };
-    for (int i = 0; i < 6; ++i) {
-      const double dq = std::fabs(replayed.q[i] - recorded.q[i]);
-      const double dqd = std::fabs(replayed.qd[i] - recorded.qd[i]);
-      max_q = std::fmax(max_q, dq);
-      max_qd = std::fmax(max_qd, dqd);
-      max_sigma =
-          std::fmax(max_sigma, std::fmax(sigmas(dq, recorded.q_std[i], replayed.q_std[i]),
-                                         sigmas(dqd, recorded.qd_std[i], replayed.qd_std[i])));
-    }
+    if (recorded.status != replayed.status && intact) ++r.status_differ;
+    (intact ? r.state : r.after_gap).Add(replayed, recorded);
   };
 
   if (r.perfect_state) {
@@ -515,10 +537,7 @@ EstimatorReplayResult ReplayEstimator(const StackConfig& config, const RecordedL
       }
     }
   }
-  r.recorded_estimates = static_cast<long>(log.estimates.size());
-  for (const state_t& recorded : log.estimates) {
-    if (replayed_samples.count(recorded.sample_utime) == 0) ++r.recorded_without_replay;
-  }
+  recorded_estimates.Finish();
   return r;
 }
 

@@ -34,6 +34,94 @@ ordered_json ToJson(const TimeStats& t) {
   return j;
 }
 
+/// An OutputPairing under its replay's names: "recorded_<noun>s",
+/// "without_recorded_<noun>".
+ordered_json ToJson(const OutputPairing& p, const std::string& noun) {
+  return {{"replayed", p.replayed},
+          {"recorded_" + noun + "s", p.recorded},
+          {"without_recorded_" + noun, p.without_recorded},
+          {"recorded_without_replay", p.recorded_without_replay}};
+}
+
+ordered_json ToJson(const EstimateDiff& d) {
+  ordered_json j = ToJson(d.values, "");
+  j["max_abs_diff_q"] = Number(d.max_abs_diff_q);
+  j["max_abs_diff_qd"] = Number(d.max_abs_diff_qd);
+  j["max_diff_sigma"] = Number(d.max_diff_sigma);
+  return j;
+}
+
+ordered_json ToJson(const SafetyReplayResult& s, const std::string& variant_source) {
+  ordered_json j = {
+      {"variant", ToString(s.variant)},
+      {"variant_source", variant_source},
+      {"qp_solver", s.qp_solver.empty() ? ordered_json(nullptr) : ordered_json(s.qp_solver)},
+      {"force_limits", s.force_limits},
+      {"k_position", s.k_position},
+      {"k_velocity", s.k_velocity},
+      {"recorded_variant",
+       s.recorded_variant ? ordered_json(ToString(*s.recorded_variant)) : ordered_json(nullptr)},
+      {"recorded_force_limits",
+       s.recorded_force_limits ? ordered_json(*s.recorded_force_limits) : ordered_json(nullptr)},
+      {"states", s.states},
+      {"nominal_commands", s.nominal_commands},
+      {"without_state", s.without_state}};
+  j.update(ToJson(s.commands, "command"));
+  j["answered_by_fallback"] = s.answered_by_fallback;
+  j["log_gap"] = s.log_gap;
+  j.update(ToJson(s.filter, "_n"));
+  j["flags_differ"] = s.flags_differ;
+  j["diagnostics_differ"] = s.diagnostics_differ;
+  ordered_json fallback = {{"recorded", s.fallback_commands},
+                           {"stale_input", s.fallback_stale_input},
+                           {"invalid_state", s.fallback_invalid_state},
+                           {"by_filter", s.fallback_by_filter},
+                           {"without_input", s.fallback_without_input}};
+  fallback.update(ToJson(s.fallback, "_n"));
+  j["fallback"] = fallback;
+  j["compute_ns"] = {{"replayed", ToJson(s.replayed_ns)}, {"recorded", ToJson(s.recorded_ns)}};
+  ordered_json cases;
+  for (size_t i = 0; i < s.replayed_cases.size(); ++i) {
+    cases[std::string(safety::kFilterCaseNames.entries[i].second)] = s.replayed_cases[i];
+  }
+  j["replayed_cases"] = cases;
+  return j;
+}
+
+ordered_json ToJson(const ControllerReplayResult& c) {
+  ordered_json j = {{"scenario", c.scenario},
+                    {"time_origin_utime", c.time_origin_utime},
+                    {"time_origin_inferred", c.time_origin_inferred},
+                    {"states", c.states},
+                    {"invalid_states", c.invalid_states},
+                    {"step_rejected", c.step_rejected}};
+  j.update(ToJson(c.commands, "command"));
+  j.update(ToJson(c.nominal, "_n"));
+  j["flags_differ"] = c.flags_differ;
+  return j;
+}
+
+ordered_json ToJson(const EstimatorReplayResult& e) {
+  ordered_json j = {{"perfect_state", e.perfect_state},
+                    {"sensor_samples", e.sensor_samples},
+                    {"commands", e.commands},
+                    {"rejected_commands", e.rejected_commands}};
+  j.update(ToJson(e.estimates, "estimate"));
+  j.update(ToJson(e.state));
+  j["status_differ"] = e.status_differ;
+  j["inputs_missing"] = e.inputs_missing;
+  j["inputs_intact_until_utime"] = e.inputs_intact_until_utime;
+  j["after_gap"] = ToJson(e.after_gap);
+  return j;
+}
+
+std::string Unmatched(const OutputPairing& p) {
+  return fmt::format(
+      "  unmatched             {} replayed without a recorded one, {} recorded without a "
+      "replayed one\n",
+      p.without_recorded, p.recorded_without_replay);
+}
+
 std::string Us(const TimeStats& t) {
   if (t.count == 0) return "n/a";
   return fmt::format("p50 {:.2f} us, p99 {:.2f} us", t.p50_ns * 1e-3, t.p99_ns * 1e-3);
@@ -59,7 +147,7 @@ long ReplayReport::Differing() const {
   long n = 0;
   if (safety) n += safety->filter.differing() + safety->fallback.differing();
   if (controller) n += controller->nominal.differing();
-  if (estimator) n += estimator->state.differing();
+  if (estimator) n += estimator->state.values.differing();
   return n;
 }
 
@@ -67,7 +155,7 @@ long ReplayReport::Compared() const {
   long n = 0;
   if (safety) n += safety->filter.compared + safety->fallback.compared;
   if (controller) n += controller->nominal.compared;
-  if (estimator) n += estimator->state.compared;
+  if (estimator) n += estimator->state.values.compared;
   return n;
 }
 
@@ -93,83 +181,9 @@ ordered_json ToJson(const ReplayReport& report) {
   }
   j["log_gaps"] = gaps;
 
-  if (report.safety) {
-    const SafetyReplayResult& s = *report.safety;
-    ordered_json js;
-    js["variant"] = ToString(s.variant);
-    js["variant_source"] = report.variant_source;
-    js["qp_solver"] = s.qp_solver.empty() ? ordered_json(nullptr) : ordered_json(s.qp_solver);
-    js["force_limits"] = s.force_limits;
-    js["k_position"] = s.k_position;
-    js["k_velocity"] = s.k_velocity;
-    js["recorded_variant"] =
-        s.recorded_variant ? ordered_json(ToString(*s.recorded_variant)) : ordered_json(nullptr);
-    js["recorded_force_limits"] =
-        s.recorded_force_limits ? ordered_json(*s.recorded_force_limits) : ordered_json(nullptr);
-    js["nominal_commands"] = s.nominal_commands;
-    js["without_state"] = s.without_state;
-    js["without_recorded_command"] = s.without_recorded_command;
-    js["answered_by_fallback"] = s.answered_by_fallback;
-    js.update(ToJson(s.filter, "_n"));
-    js["flags_differ"] = s.flags_differ;
-    ordered_json fallback;
-    fallback["recorded"] = s.fallback_commands;
-    fallback["stale_input"] = s.fallback_stale_input;
-    fallback["invalid_state"] = s.fallback_invalid_state;
-    fallback["by_filter"] = s.fallback_by_filter;
-    fallback["without_input"] = s.fallback_without_input;
-    fallback.update(ToJson(s.fallback, "_n"));
-    js["fallback"] = fallback;
-    js["compute_ns"] = {{"replayed", ToJson(s.replayed_ns)}, {"recorded", ToJson(s.recorded_ns)}};
-    ordered_json cases;
-    for (size_t i = 0; i < s.replayed_cases.size(); ++i) {
-      cases[std::string(safety::kFilterCaseNames.entries[i].second)] = s.replayed_cases[i];
-    }
-    js["replayed_cases"] = cases;
-    j["safety"] = js;
-  }
-  if (report.controller) {
-    const ControllerReplayResult& c = *report.controller;
-    ordered_json jc;
-    jc["scenario"] = c.scenario;
-    jc["time_origin_utime"] = c.time_origin_utime;
-    jc["time_origin_inferred"] = c.time_origin_inferred;
-    jc["states"] = c.states;
-    jc["invalid_states"] = c.invalid_states;
-    jc["step_rejected"] = c.step_rejected;
-    jc["replayed"] = c.replayed;
-    jc["recorded_commands"] = c.recorded_commands;
-    jc["without_recorded_command"] = c.without_recorded_command;
-    jc["recorded_without_replay"] = c.recorded_without_replay;
-    jc.update(ToJson(c.nominal, "_n"));
-    jc["flags_differ"] = c.flags_differ;
-    j["controller"] = jc;
-  }
-  if (report.estimator) {
-    const EstimatorReplayResult& e = *report.estimator;
-    ordered_json je;
-    je["perfect_state"] = e.perfect_state;
-    je["sensor_samples"] = e.sensor_samples;
-    je["commands"] = e.commands;
-    je["rejected_commands"] = e.rejected_commands;
-    je["replayed"] = e.replayed;
-    je["recorded_estimates"] = e.recorded_estimates;
-    je["without_recorded_estimate"] = e.without_recorded_estimate;
-    je["recorded_without_replay"] = e.recorded_without_replay;
-    je.update(ToJson(e.state, ""));
-    je["max_abs_diff_q"] = Number(e.max_abs_diff_q);
-    je["max_abs_diff_qd"] = Number(e.max_abs_diff_qd);
-    je["max_diff_sigma"] = Number(e.max_diff_sigma);
-    je["status_differ"] = e.status_differ;
-    je["inputs_missing"] = e.inputs_missing;
-    je["inputs_intact_until_utime"] = e.inputs_intact_until_utime;
-    ordered_json after = ToJson(e.after_gap, "");
-    after["max_abs_diff_q"] = Number(e.max_abs_diff_q_after_gap);
-    after["max_abs_diff_qd"] = Number(e.max_abs_diff_qd_after_gap);
-    after["max_diff_sigma"] = Number(e.max_diff_sigma_after_gap);
-    je["after_gap"] = after;
-    j["estimator"] = je;
-  }
+  if (report.safety) j["safety"] = ToJson(*report.safety, report.variant_source);
+  if (report.controller) j["controller"] = ToJson(*report.controller);
+  if (report.estimator) j["estimator"] = ToJson(*report.estimator);
   j["compared"] = report.Compared();
   j["differing"] = report.Differing();
   j["identical"] = report.Differing() == 0;
@@ -206,20 +220,29 @@ std::string FormatSummary(const ReplayReport& report) {
         s.recorded_variant ? ToString(*s.recorded_variant) : "no diagnostics",
         s.recorded_force_limits && *s.recorded_force_limits ? ", force limits on" : "");
     o += fmt::format(
-        "  nominal commands      {} ({} without an estimate, {} without a recorded safe "
-        "command)\n",
-        s.nominal_commands, s.without_state, s.without_recorded_command);
-    o += fmt::format("  filter commands       {}; {}; flags differ {}\n", Identical(s.filter),
-                     Worst(s.filter, "N"), s.flags_differ);
+        "  inputs                {} estimates, {} nominal commands ({} without an estimate)\n",
+        s.states, s.nominal_commands, s.without_state);
+    o += fmt::format("  safe commands         {} replayed, {} recorded\n", s.commands.replayed,
+                     s.commands.recorded);
+    o += fmt::format("  filter commands       {}; {}; flags differ {}, diagnostics differ {}\n",
+                     Identical(s.filter), Worst(s.filter, "N"), s.flags_differ,
+                     s.diagnostics_differ);
     o += fmt::format(
-        "  answered by fallback  {} nominal commands (the live node sent a fallback; not "
-        "compared above)\n",
+        "  answered by fallback  {} nominal commands (the live process sent a fallback; "
+        "compared below)\n",
         s.answered_by_fallback);
     o += fmt::format(
         "  fallback commands     {} recorded: {} stale input, {} invalid state, {} filter last "
         "resort, {} not replayable; {}; {}\n",
         s.fallback_commands, s.fallback_stale_input, s.fallback_invalid_state, s.fallback_by_filter,
         s.fallback_without_input, Identical(s.fallback), Worst(s.fallback, "N"));
+    if (s.log_gap > 0) {
+      o += fmt::format(
+          "  log gap               {} watchdog fallbacks of the replay where the log lacks "
+          "nominal commands the live process had: not compared\n",
+          s.log_gap);
+    }
+    o += Unmatched(s.commands);
     o += fmt::format("  filter time per step  replay {} | live {} ({} steps)\n", Us(s.replayed_ns),
                      Us(s.recorded_ns), s.replayed_ns.count);
     o += "  replayed cases       ";
@@ -239,12 +262,9 @@ std::string FormatSummary(const ReplayReport& report) {
         "  states                {} ({} not valid: skipped, {} rejected by the controller)\n",
         c.states, c.invalid_states, c.step_rejected);
     o += fmt::format("  nominal commands      {} replayed, {} recorded; {}; {}; flags differ {}\n",
-                     c.replayed, c.recorded_commands, Identical(c.nominal), Worst(c.nominal, "N"),
-                     c.flags_differ);
-    o += fmt::format(
-        "  unmatched             {} replayed without a recorded one, {} recorded "
-        "without a replayed one\n",
-        c.without_recorded_command, c.recorded_without_replay);
+                     c.commands.replayed, c.commands.recorded, Identical(c.nominal),
+                     Worst(c.nominal, "N"), c.flags_differ);
+    o += Unmatched(c.commands);
   }
   if (report.estimator) {
     const EstimatorReplayResult& e = *report.estimator;
@@ -255,20 +275,17 @@ std::string FormatSummary(const ReplayReport& report) {
     o += fmt::format(
         "  estimates             {} replayed, {} recorded; {}; max |dq| {:.3g}, max |dqd| {:.3g}, "
         "status differs {}\n",
-        e.replayed, e.recorded_estimates, Identical(e.state), e.max_abs_diff_q, e.max_abs_diff_qd,
-        e.status_differ);
-    o += fmt::format(
-        "  unmatched             {} replayed without a recorded one, {} recorded "
-        "without a replayed one\n",
-        e.without_recorded_estimate, e.recorded_without_replay);
+        e.estimates.replayed, e.estimates.recorded, Identical(e.state.values),
+        e.state.max_abs_diff_q, e.state.max_abs_diff_qd, e.status_differ);
+    o += Unmatched(e.estimates);
     if (e.inputs_missing > 0) {
       o += fmt::format(
           "  after the log gap     {} inputs missing from the log after utime {}: the {} later "
           "estimates are not comparable (not counted above): {} bit-identical, max |dq| {:.3g}, "
           "max |dqd| {:.3g}, max {:.3g} sigma\n",
-          e.inputs_missing, e.inputs_intact_until_utime, e.after_gap.compared,
-          e.after_gap.identical, e.max_abs_diff_q_after_gap, e.max_abs_diff_qd_after_gap,
-          e.max_diff_sigma_after_gap);
+          e.inputs_missing, e.inputs_intact_until_utime, e.after_gap.values.compared,
+          e.after_gap.values.identical, e.after_gap.max_abs_diff_q, e.after_gap.max_abs_diff_qd,
+          e.after_gap.max_diff_sigma);
     }
   }
   const long differing = report.Differing();
@@ -289,9 +306,10 @@ void WriteSafetyStepsCsv(const SafetyReplayResult& safety, std::ostream& out) {
   for (int i = 0; i < 6; ++i) out << ",f_recorded" << i << "_n";
   out << '\n' << std::setprecision(17);
   for (const SafetyStep& step : safety.steps) {
-    out << step.sample_utime << ',' << kSafetyStepKindNames.Name(step.kind) << ',' << step.replayed_flags << ','
-        << step.recorded_flags << ',' << static_cast<int>(step.replayed_case) << ','
-        << step.replayed_ns << ',' << step.recorded_ns;
+    out << step.sample_utime << ',' << kSafetyStepKindNames.Name(step.kind) << ','
+        << step.replayed_flags << ',' << step.recorded_flags << ','
+        << static_cast<int>(step.replayed_case) << ',' << step.replayed_ns << ','
+        << step.recorded_ns;
     for (double f : step.f_replayed) out << ',' << f;
     for (double f : step.f_recorded) out << ',' << f;
     out << '\n';

@@ -8,7 +8,7 @@
 
 #include <string>
 
-#include "stewart/config/config_loader.h"
+#include "stewart/config/default_config.h"
 #include "stewart/config/scenario_loader.h"
 #include "stewart/controller/scenario.h"
 #include "stewart/stack/closed_loop.h"
@@ -17,11 +17,6 @@ namespace stewart {
 namespace {
 
 constexpr double kLimitTolerance = 1e-3;  // m and m/s, docs/safety.md "Tolerance"
-
-const StackConfig& Config() {
-  static const StackConfig config = LoadStackConfig(DefaultConfigPath());
-  return config;
-}
 
 ClosedLoopSummary RunScenario(const StackConfig& config, const std::string& scenario_name,
                               std::uint64_t seed, bool perfect_state = false,
@@ -38,11 +33,11 @@ class ScenarioLimits : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(ScenarioLimits, HoldOnGroundTruthWithTheEkfForSeveralSeeds) {
   for (std::uint64_t seed : {1u, 2u, 3u}) {
-    const ClosedLoopSummary s = RunScenario(Config(), GetParam(), seed);
+    const ClosedLoopSummary s = RunScenario(DefaultStackConfig(), GetParam(), seed);
     ASSERT_TRUE(s.completed);
     EXPECT_LE(s.max_limit_excess, kLimitTolerance)
         << GetParam() << " seed " << seed << ": " << s.max_limit_excess_name << "\n"
-        << FormatSummary(Config(), s);
+        << FormatSummary(DefaultStackConfig(), s);
     EXPECT_EQ(s.infeasible_ticks, 0);
     EXPECT_EQ(s.estimator_reinits, 0);
     // The estimator's accuracy in the loop (the bounds of docs/estimator.md):
@@ -64,7 +59,7 @@ INSTANTIATE_TEST_SUITE_P(Shipped, ScenarioLimits,
                          });
 
 TEST(PaperScenario, TracksTheSetpointsTheLimitsAllow) {
-  const ClosedLoopSummary s = RunScenario(Config(), "paper", 1);
+  const ClosedLoopSummary s = RunScenario(DefaultStackConfig(), "paper", 1);
   // Fig. 5 of the paper: x and y reach 0.1 m, z reaches 0.5 m at the
   // limited speeds, nothing rotates much.
   EXPECT_NEAR(s.q_max(0), 0.1, 2e-3);
@@ -72,7 +67,7 @@ TEST(PaperScenario, TracksTheSetpointsTheLimitsAllow) {
   EXPECT_NEAR(s.q_max(2), 0.5, 2e-3);
   // Cruising just below the velocity limit: the robust margin keeps
   // h_v >= margin / 1 s in steady state.
-  const double margin = Config().safety.velocity_robust_margin_mps2;
+  const double margin = DefaultStackConfig().safety.velocity_robust_margin_mps2;
   EXPECT_LT(s.qd_max(0), 0.015);
   EXPECT_GT(s.qd_max(0), 0.015 - margin - 1e-3);
   EXPECT_LT(s.q_max.tail<3>().cwiseAbs().maxCoeff(), 0.05);
@@ -84,21 +79,21 @@ TEST(CorrectionMetric, ForceMetricLetsRotationsAbsorbTheCorrection) {
   // change that meets the composed velocity condition tilts the platform;
   // the tilt grows until the limits are lost. 12 s of the paper scenario
   // with perfect state shows it (docs/safety.md, "Correction metric").
-  StackConfig force_metric = Config();
+  StackConfig force_metric = DefaultStackConfig();
   force_metric.safety.correction_metric = CorrectionMetric::kForce;
   const ClosedLoopSummary bad = RunScenario(force_metric, "paper", 1, true, 12.0);
-  const ClosedLoopSummary good = RunScenario(Config(), "paper", 1, true, 12.0);
+  const ClosedLoopSummary good = RunScenario(DefaultStackConfig(), "paper", 1, true, 12.0);
   EXPECT_GT(bad.max_limit_excess, 10 * kLimitTolerance) << FormatSummary(force_metric, bad);
   EXPECT_GT(bad.q_max.tail<3>().cwiseAbs().maxCoeff() + bad.q_min.tail<3>().cwiseAbs().maxCoeff(),
             0.1);
-  EXPECT_LE(good.max_limit_excess, kLimitTolerance) << FormatSummary(Config(), good);
+  EXPECT_LE(good.max_limit_excess, kLimitTolerance) << FormatSummary(DefaultStackConfig(), good);
 }
 
 TEST(LegFriction, UnmodelledFrictionCostsTracking) {
   // Without the friction in the controller and filter the CBF conditions are
   // met by the model but not by the plant, and lead-screw drag keeps the
   // platform far from its targets.
-  StackConfig no_friction_model = Config();
+  StackConfig no_friction_model = DefaultStackConfig();
   no_friction_model.controller.leg_friction_nspm = 0.0;
   no_friction_model.safety.leg_friction_nspm = 0.0;
   const ClosedLoopSummary s = RunScenario(no_friction_model, "paper", 1, true, 10.0);

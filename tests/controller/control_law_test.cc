@@ -4,15 +4,10 @@
 
 #include <gtest/gtest.h>
 
-#include "stewart/config/config_loader.h"
+#include "stewart/config/default_config.h"
 
 namespace stewart {
 namespace {
-
-const StackConfig& Config() {
-  static const StackConfig config = LoadStackConfig(DefaultConfigPath());
-  return config;
-}
 
 TEST(ControlLaw, PdAccelerationOnKnownValues) {
   ControllerConfig gains;
@@ -37,7 +32,7 @@ TEST(ControlLaw, PdAccelerationOnKnownValues) {
 }
 
 TEST(ControlLaw, AtTheSetpointAtRestHoldsAgainstGravity) {
-  const StackConfig& c = Config();
+  const StackConfig& c = DefaultStackConfig();
   Vector6d pose;
   pose << 0.03, -0.02, 0.45, 0.05, -0.04, 0.1;
   DynamicsTerms terms;
@@ -51,7 +46,7 @@ TEST(ControlLaw, AtTheSetpointAtRestHoldsAgainstGravity) {
 }
 
 TEST(ControlLaw, SolvesTheDynamicsEquation) {
-  const StackConfig& c = Config();
+  const StackConfig& c = DefaultStackConfig();
   Vector6d q, qd;
   q << 0.02, 0.01, 0.42, 0.03, 0.02, -0.05;
   qd << 0.01, -0.02, 0.005, 0.1, -0.05, 0.2;
@@ -88,7 +83,7 @@ void Rk4Step(const PlatformParams& p, double b, const Vector6d& f, double dt, Ve
 }
 
 TEST(ControlLaw, ClosedLoopConvergesToAReachableSetpoint) {
-  const StackConfig& c = Config();
+  const StackConfig& c = DefaultStackConfig();
   Vector6d q = c.home_pose, qd = Vector6d::Zero();
   Vector6d target;
   target << 0.05, -0.03, 0.45, 0.05, -0.03, 0.1;

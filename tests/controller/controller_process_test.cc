@@ -1,9 +1,6 @@
 // The real controller process over LCM on a private URL (ports 7780-7789).
 #include <gtest/gtest.h>
 #include <signal.h>
-#include <spawn.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <chrono>
 #include <cmath>
@@ -12,56 +9,18 @@
 #include <string>
 #include <vector>
 
-#include "stewart/config/config_loader.h"
+#include "stewart/config/default_config.h"
 #include "stewart/force_command_t.hpp"
 #include "stewart/health_t.hpp"
 #include "stewart/node/lcm_handle.h"
 #include "stewart/setpoint_t.hpp"
 #include "stewart/state_t.hpp"
-
-extern char** environ;
+#include "stewart/test_support/child_process.h"
 
 namespace stewart {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-class Process {
- public:
-  explicit Process(std::vector<std::string> args) {
-    std::vector<char*> argv;
-    for (auto& a : args) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    if (posix_spawn(&pid_, argv[0], nullptr, nullptr, argv.data(), environ) != 0) pid_ = -1;
-  }
-  ~Process() {
-    if (pid_ > 0 && !exited_) {
-      kill(pid_, SIGTERM);
-      Wait(std::chrono::seconds(5));
-      if (!exited_) kill(pid_, SIGKILL);
-      waitpid(pid_, nullptr, 0);
-    }
-  }
-  bool started() const { return pid_ > 0; }
-  /// Exit status, or -1 if still running after `timeout`.
-  int Wait(Clock::duration timeout) {
-    const auto end = Clock::now() + timeout;
-    while (Clock::now() < end) {
-      int status = 0;
-      if (waitpid(pid_, &status, WNOHANG) == pid_) {
-        exited_ = true;
-        return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-      }
-      usleep(10000);
-    }
-    return -1;
-  }
-  void Terminate() { kill(pid_, SIGTERM); }
-
- private:
-  pid_t pid_ = -1;
-  bool exited_ = false;
-};
 
 struct Inbox {
   std::vector<force_command_t> commands;
@@ -78,11 +37,6 @@ struct Inbox {
   }
 };
 
-const StackConfig& Config() {
-  static const StackConfig config = LoadStackConfig(DefaultConfigPath());
-  return config;
-}
-
 state_t State(int64_t utime, const Vector6d& q) {
   state_t s{};
   s.utime = utime;
@@ -98,7 +52,7 @@ class ControllerProcess : public ::testing::Test {
   void Connect(int port) {
     url_ = PrivateLcmUrl(port);
     lcm_ = MakeLcm(url_);
-    const auto& ch = Config().lcm.channels;
+    const auto& ch = DefaultStackConfig().lcm.channels;
     lcm_->subscribe(ch.command_nominal, &Inbox::OnCommand, &inbox_)->setQueueCapacity(10000);
     lcm_->subscribe(ch.setpoint, &Inbox::OnSetpoint, &inbox_)->setQueueCapacity(10000);
     lcm_->subscribe(ch.health, &Inbox::OnHealth, &inbox_)->setQueueCapacity(1000);
@@ -112,7 +66,7 @@ class ControllerProcess : public ::testing::Test {
   int PublishUntilAnswered(state_t state, int timeout_ms = 5000) {
     const auto end = Clock::now() + std::chrono::milliseconds(timeout_ms);
     while (Clock::now() < end) {
-      lcm_->publish(Config().lcm.channels.state_estimate, &state);
+      lcm_->publish(DefaultStackConfig().lcm.channels.state_estimate, &state);
       Drain(20);
       for (std::size_t i = 0; i < inbox_.commands.size(); ++i) {
         if (inbox_.commands[i].sample_utime == state.sample_utime) return static_cast<int>(i);
@@ -130,14 +84,14 @@ class ControllerProcess : public ::testing::Test {
 
 TEST_F(ControllerProcess, AnswersStatesWithTheirSampleUtime) {
   Connect(7780);
-  Process p({CONTROLLER_PATH, "--lcm-url", url_});
+  test::ChildProcess p({CONTROLLER_PATH, "--lcm-url", url_});
   ASSERT_TRUE(p.started());
-  const int first = PublishUntilAnswered(State(1'000'000, Config().home_pose));
+  const int first = PublishUntilAnswered(State(1'000'000, DefaultStackConfig().home_pose));
   ASSERT_GE(first, 0) << "no force_command_t from the controller";
 
   const int64_t t = inbox_.commands[first].sample_utime + 1000;
   inbox_.commands.clear();
-  const int i = PublishUntilAnswered(State(t, Config().home_pose));
+  const int i = PublishUntilAnswered(State(t, DefaultStackConfig().home_pose));
   ASSERT_GE(i, 0);
   const force_command_t& cmd = inbox_.commands[i];
   EXPECT_EQ(cmd.sample_utime, t);
@@ -153,16 +107,16 @@ TEST_F(ControllerProcess, AnswersStatesWithTheirSampleUtime) {
   EXPECT_TRUE(inbox_.setpoints.empty());
 
   // A NaN state is rejected: no command for it, ever.
-  state_t bad = State(t + 1000, Config().home_pose);
+  state_t bad = State(t + 1000, DefaultStackConfig().home_pose);
   bad.qd[2] = std::nan("");
-  lcm_->publish(Config().lcm.channels.state_estimate, &bad);
+  lcm_->publish(DefaultStackConfig().lcm.channels.state_estimate, &bad);
   // An outside-workspace setpoint: rejected, flagged on the next command.
   setpoint_t sp{};
   sp.utime = t;
   sp.q_des[2] = 1.5;
-  lcm_->publish(Config().lcm.channels.setpoint, &sp);
+  lcm_->publish(DefaultStackConfig().lcm.channels.setpoint, &sp);
   Drain(100);
-  const int j = PublishUntilAnswered(State(t + 2000, Config().home_pose));
+  const int j = PublishUntilAnswered(State(t + 2000, DefaultStackConfig().home_pose));
   ASSERT_GE(j, 0);
   EXPECT_EQ(inbox_.commands[j].flags & force_command_t::FLAG_SETPOINT_REJECTED,
             force_command_t::FLAG_SETPOINT_REJECTED);
@@ -173,7 +127,7 @@ TEST_F(ControllerProcess, AnswersStatesWithTheirSampleUtime) {
 
   // The health heartbeat counts both rejections.
   inbox_.health.clear();
-  p.Terminate();
+  p.Signal(SIGTERM);
   EXPECT_EQ(p.Wait(std::chrono::seconds(5)), 0);
   Drain(100);
   ASSERT_FALSE(inbox_.health.empty());
@@ -195,15 +149,15 @@ TEST_F(ControllerProcess, FollowsAScenarioEchoesItAndExitsAtTheEnd) {
   std::ofstream(path) << "name: short\nduration_s: 0.5\nsegments:\n"
                          "  - {start_s: 0, type: step, q_des: [0.02, 0, 0.4, 0, 0, 0]}\n"
                          "  - {start_s: 0.25, type: step, q_des: [0, 0.03, 0.41, 0, 0, 0]}\n";
-  Process p({CONTROLLER_PATH, "--lcm-url", url_, "--scenario", path, "--exit-at-end"});
+  test::ChildProcess p({CONTROLLER_PATH, "--lcm-url", url_, "--scenario", path, "--exit-at-end"});
   ASSERT_TRUE(p.started());
   const int64_t t0 = 5'000'000;
-  const int first = PublishUntilAnswered(State(t0, Config().home_pose));
+  const int first = PublishUntilAnswered(State(t0, DefaultStackConfig().home_pose));
   ASSERT_GE(first, 0);
   const int64_t start = inbox_.commands[first].sample_utime;  // scenario t = 0
   for (int64_t dt = 10'000; dt <= 600'000; dt += 10'000) {
-    const state_t state = State(start + dt, Config().home_pose);
-    lcm_->publish(Config().lcm.channels.state_estimate, &state);
+    const state_t state = State(start + dt, DefaultStackConfig().home_pose);
+    lcm_->publish(DefaultStackConfig().lcm.channels.state_estimate, &state);
     Drain(2);
   }
   EXPECT_EQ(p.Wait(std::chrono::seconds(5)), 0) << "did not exit at the scenario's end";

@@ -6,16 +6,11 @@
 
 #include <cmath>
 
-#include "stewart/config/config_loader.h"
+#include "stewart/config/default_config.h"
 #include "stewart/config/scenario_loader.h"
 
 namespace stewart {
 namespace {
-
-const StackConfig& Config() {
-  static const StackConfig config = LoadStackConfig(DefaultConfigPath());
-  return config;
-}
 
 std::string ScenarioFile(const std::string& name) {
   return std::string(STEWART_SOURCE_DIR) + "/config/scenarios/" + name + ".yaml";
@@ -51,7 +46,8 @@ TEST(Scenario, PaperIsExactlyTheNotes) {
 TEST(Scenario, ShippedScenariosStayInsideTheWorkspace) {
   for (const char* name : {"paper", "beyond-limits", "circle"}) {
     const Scenario s = LoadScenario(ScenarioFile(name));
-    EXPECT_FALSE(FirstTimeOutsideWorkspace(s, Config().platform, 0.005).has_value()) << name;
+    EXPECT_FALSE(FirstTimeOutsideWorkspace(s, DefaultStackConfig().platform, 0.005).has_value())
+        << name;
   }
 }
 
@@ -67,8 +63,8 @@ double MaxOverTime(const Scenario& s, int axis, bool velocity) {
 
 TEST(Scenario, BeyondLimitsGoesPastEveryPositionLimit) {
   const Scenario s = LoadScenario(ScenarioFile("beyond-limits"));
-  ASSERT_FALSE(Config().safety.position_limits.empty());
-  for (const PositionLimitConfig& limit : Config().safety.position_limits) {
+  ASSERT_FALSE(DefaultStackConfig().safety.position_limits.empty());
+  for (const PositionLimitConfig& limit : DefaultStackConfig().safety.position_limits) {
     if (limit.upper) {
       EXPECT_GT(MaxOverTime(s, limit.axis, false), *limit.upper + 0.01) << limit.axis;
     }
@@ -84,7 +80,7 @@ TEST(Scenario, BeyondLimitsGoesPastEveryPositionLimit) {
 
 TEST(Scenario, CircleGrazesTheLimitsSmoothly) {
   const Scenario s = LoadScenario(ScenarioFile("circle"));
-  const SafetyConfig& safety = Config().safety;
+  const SafetyConfig& safety = DefaultStackConfig().safety;
   for (const PositionLimitConfig& limit : safety.position_limits) {
     if (!limit.upper) continue;
     const double peak = MaxOverTime(s, limit.axis, false);
@@ -110,8 +106,8 @@ TEST(Scenario, CircleGrazesTheLimitsSmoothly) {
     EXPECT_LT(((c.qd_des - a.qd_des) / (2 * h) - b.qdd_des).norm(), 1e-6) << "t = " << t;
   }
   // It starts and ends at home, at rest.
-  EXPECT_LT((s.Evaluate(0).q_des - Config().home_pose).norm(), 1e-12);
-  EXPECT_LT((s.Evaluate(s.duration_s()).q_des - Config().home_pose).norm(), 1e-12);
+  EXPECT_LT((s.Evaluate(0).q_des - DefaultStackConfig().home_pose).norm(), 1e-12);
+  EXPECT_LT((s.Evaluate(s.duration_s()).q_des - DefaultStackConfig().home_pose).norm(), 1e-12);
   EXPECT_TRUE(s.Evaluate(s.duration_s()).qd_des.isZero());
 }
 

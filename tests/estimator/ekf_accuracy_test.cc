@@ -58,19 +58,23 @@ TEST(EkfAccuracy, DefaultConfigIsDynamicsAndNotPerfectState) {
   EXPECT_FALSE(EstimatorTestConfig().estimator.perfect_state);
 }
 
+/// The paper scenario (noise seed 1) on the sensors of `truth`, estimated by
+/// the EKF of `filter`; printed as `name`.
+RunStats RunPaper(const char* name, const StackConfig& truth, const StackConfig& filter) {
+  Ekf ekf = MakeEkf(filter);
+  const RunStats s = RunScenario(truth, 1, ScenarioTruth::kDurationS, 1.0, &ekf);
+  Print(name, s);
+  return s;
+}
+
 TEST(EkfAccuracy, ConstantVelocityModelOnPaperScenario) {
   const StackConfig c = WithModel(EstimatorProcessModel::kConstantVelocity);
-  Ekf ekf = MakeEkf(c);
-  const RunStats s = RunScenario(c, 1, ScenarioTruth::kDurationS, 1.0, &ekf);
-  Print("constant velocity", s);
-  ExpectWithin(s, kConstantVelocityBounds);
+  ExpectWithin(RunPaper("constant velocity", c, c), kConstantVelocityBounds);
 }
 
 TEST(EkfAccuracy, DynamicsModelOnPaperScenario) {
   const StackConfig c = WithModel(EstimatorProcessModel::kDynamics);
-  Ekf ekf = MakeEkf(c);
-  const RunStats s = RunScenario(c, 1, ScenarioTruth::kDurationS, 1.0, &ekf);
-  Print("dynamics (exact model)", s);
+  const RunStats s = RunPaper("dynamics (exact model)", c, c);
   ExpectWithin(s, kDynamicsBounds);
   EXPECT_EQ(s.Count(kEventNoCommand), 0);
 }
@@ -80,10 +84,9 @@ TEST(EkfAccuracy, DynamicsModelOnPaperScenario) {
 TEST(EkfAccuracy, AblationsAndModelMismatch) {
   for (auto model : {EstimatorProcessModel::kConstantVelocity, EstimatorProcessModel::kDynamics}) {
     const StackConfig c = WithModel(model, false);
-    Ekf ekf = MakeEkf(c);
-    const RunStats s = RunScenario(c, 1, ScenarioTruth::kDurationS, 1.0, &ekf);
-    Print(model == EstimatorProcessModel::kDynamics ? "dynamics, no accel" : "const vel, no accel",
-          s);
+    RunPaper(
+        model == EstimatorProcessModel::kDynamics ? "dynamics, no accel" : "const vel, no accel", c,
+        c);
   }
   RunStats mismatch[2];
   int i = 0;
@@ -93,9 +96,7 @@ TEST(EkfAccuracy, AblationsAndModelMismatch) {
     wrong.platform.platform_mass_kg *= 0.9;
     wrong.platform.leg.rod_mass_kg *= 0.9;
     wrong.actuators.viscous_friction_nspm = 0.0;
-    Ekf ekf = MakeEkf(wrong);
-    mismatch[i] = RunScenario(c, 1, ScenarioTruth::kDurationS, 1.0, &ekf);
-    Print(i == 0 ? "const vel, mass -10%" : "dynamics, mass -10%", mismatch[i]);
+    mismatch[i] = RunPaper(i == 0 ? "const vel, mass -10%" : "dynamics, mass -10%", c, wrong);
     std::printf("  gated leg updates %d, divergences %d\n", mismatch[i].Count(kGateLegs),
                 mismatch[i].Count(kEventDiverged));
     ++i;

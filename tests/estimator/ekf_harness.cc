@@ -1,6 +1,6 @@
 #include "ekf_harness.h"
 
-#include "stewart/config/config_loader.h"
+#include "stewart/config/default_config.h"
 
 namespace stewart::test {
 
@@ -11,10 +11,7 @@ int RunStats::Count(EkfEvent e) const {
   return 0;
 }
 
-const StackConfig& EstimatorTestConfig() {
-  static const StackConfig config = LoadStackConfig(DefaultConfigPath());
-  return config;
-}
+const StackConfig& EstimatorTestConfig() { return DefaultStackConfig(); }
 
 RunStats RunScenario(const StackConfig& config, unsigned seed, double t_end_s, double settle_s,
                      Ekf* ekf, const RunHooks& hooks, const TruthDisturbance& disturbance) {

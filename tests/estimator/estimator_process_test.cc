@@ -3,12 +3,12 @@
 // counted in its health; the perfect-state pass-through only on request.
 #include <gtest/gtest.h>
 #include <signal.h>
-#include <spawn.h>
-#include <sys/wait.h>
 
 #include <chrono>
 #include <cmath>
 #include <map>
+#include <memory>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -20,42 +20,14 @@
 #include "stewart/node/lcm_handle.h"
 #include "stewart/sensor_t.hpp"
 #include "stewart/state_t.hpp"
-
-extern char** environ;
+#include "stewart/test_support/child_process.h"
+#include "stewart/test_support/lcm_messages.h"
 
 namespace stewart::test {
 namespace {
 
 constexpr int kPortEstimate = 7720;  // this file's private LCM ports
 constexpr int kPortPerfect = 7721;
-
-// Starts the estimator binary; SIGTERM and reaps it on destruction.
-class Process {
- public:
-  explicit Process(std::vector<std::string> args) {
-    args.insert(args.begin(), ESTIMATOR_BINARY);
-    std::vector<char*> argv;
-    for (auto& a : args) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    ok_ = posix_spawn(&pid_, ESTIMATOR_BINARY, nullptr, nullptr, argv.data(), environ) == 0;
-  }
-  ~Process() {
-    if (ok_ && !stopped_) Stop();
-  }
-  int Stop() {
-    stopped_ = true;
-    kill(pid_, SIGTERM);
-    int status = 0;
-    waitpid(pid_, &status, 0);
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  }
-  bool ok() const { return ok_; }
-
- private:
-  pid_t pid_ = 0;
-  bool ok_ = false;
-  bool stopped_ = false;
-};
 
 class Sink {
  public:
@@ -68,18 +40,6 @@ class Sink {
   std::vector<state_t> states;
   std::vector<health_t> health;
 };
-
-template <typename Pred>
-bool PumpUntil(lcm::LCM* lcm, Pred done, double timeout_s) {
-  const auto deadline = std::chrono::steady_clock::now() +
-                        std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                            std::chrono::duration<double>(timeout_s));
-  while (!done()) {
-    if (std::chrono::steady_clock::now() > deadline) return false;
-    lcm->handleTimeout(20);
-  }
-  return true;
-}
 
 sensor_t ToMessage(const SensorSample& s, int64_t seq) {
   sensor_t m{};
@@ -102,19 +62,36 @@ int64_t Counter(const health_t& h, const std::string& name) {
   return 0;
 }
 
-TEST(EstimatorProcess, EstimatesCarryTheSensorSampleUtime) {
+/// The estimator process on a private LCM URL; the test publishes its inputs
+/// on `lcm` and finds its estimates and heartbeats in `sink`.
+class EstimatorProcess : public ::testing::Test {
+ protected:
+  /// Starts it with `flags` and waits for its first heartbeat (the process
+  /// is up and subscribed).
+  void Start(int port, const std::vector<std::string>& flags) {
+    const std::string url = PrivateLcmUrl(port);
+    lcm = MakeLcm(url);
+    lcm->subscribe(ch.state_estimate, &Sink::OnState, &sink)->setQueueCapacity(2000);
+    lcm->subscribe(ch.health, &Sink::OnHealth, &sink)->setQueueCapacity(100);
+    std::vector<std::string> argv = {ESTIMATOR_BINARY, "--config", DefaultConfigPath(),
+                                     "--lcm-url",      url,        "--log-level",
+                                     "error"};
+    argv.insert(argv.end(), flags.begin(), flags.end());
+    proc.emplace(argv);
+    ASSERT_TRUE(proc->started());
+    ASSERT_TRUE(HandleUntil(
+        lcm.get(), [&] { return !sink.health.empty(); }, 10.0));
+  }
+
   const StackConfig config = LoadStackConfig(DefaultConfigPath());
   const ChannelNames& ch = config.lcm.channels;
-  const std::string url = PrivateLcmUrl(kPortEstimate);
-  auto lcm = MakeLcm(url);
+  std::unique_ptr<lcm::LCM> lcm;
   Sink sink;
-  lcm->subscribe(ch.state_estimate, &Sink::OnState, &sink)->setQueueCapacity(2000);
-  lcm->subscribe(ch.health, &Sink::OnHealth, &sink)->setQueueCapacity(100);
-  Process proc({"--config", DefaultConfigPath(), "--lcm-url", url, "--log-level", "error"});
-  ASSERT_TRUE(proc.ok());
-  // Its first heartbeat: the process is up and subscribed.
-  ASSERT_TRUE(PumpUntil(
-      lcm.get(), [&] { return !sink.health.empty(); }, 10.0));
+  std::optional<ChildProcess> proc;
+};
+
+TEST_F(EstimatorProcess, EstimatesCarryTheSensorSampleUtime) {
+  ASSERT_NO_FATAL_FAILURE(Start(kPortEstimate, {}));
 
   ScenarioTruth truth(config, 11);
   constexpr int kSamples = 600;
@@ -143,7 +120,7 @@ TEST(EstimatorProcess, EstimatesCarryTheSensorSampleUtime) {
     lcm->handleTimeout(0);
     std::this_thread::sleep_for(std::chrono::microseconds(300));
   }
-  ASSERT_TRUE(PumpUntil(
+  ASSERT_TRUE(HandleUntil(
       lcm.get(), [&] { return sink.states.size() >= kSamples; }, 10.0))
       << "received " << sink.states.size();
   ASSERT_EQ(sink.states.size(), static_cast<size_t>(kSamples));
@@ -166,7 +143,7 @@ TEST(EstimatorProcess, EstimatesCarryTheSensorSampleUtime) {
     EXPECT_LT(last.q_std[j], 2e-4);
   }
   // Health: the NaN legs and the duplicate are counted rejections.
-  ASSERT_TRUE(PumpUntil(
+  ASSERT_TRUE(HandleUntil(
       lcm.get(), [&] { return sink.health.back().messages_in >= 2 * kSamples; }, 5.0));
   const health_t& h = sink.health.back();
   std::string counters;
@@ -178,22 +155,11 @@ TEST(EstimatorProcess, EstimatesCarryTheSensorSampleUtime) {
   EXPECT_EQ(Counter(h, "rejected_legs_non_finite"), 1);
   EXPECT_EQ(Counter(h, "rejected_non_increasing_time"), 1);
   EXPECT_EQ(h.messages_out, kSamples);
-  EXPECT_EQ(proc.Stop(), 0);
+  EXPECT_EQ(proc->Stop(SIGTERM), 0);
 }
 
-TEST(EstimatorProcess, PerfectStateOnlyOnRequest) {
-  const StackConfig config = LoadStackConfig(DefaultConfigPath());
-  const ChannelNames& ch = config.lcm.channels;
-  const std::string url = PrivateLcmUrl(kPortPerfect);
-  auto lcm = MakeLcm(url);
-  Sink sink;
-  lcm->subscribe(ch.state_estimate, &Sink::OnState, &sink);
-  lcm->subscribe(ch.health, &Sink::OnHealth, &sink);
-  Process proc({"--config", DefaultConfigPath(), "--lcm-url", url, "--log-level", "error",
-                "--perfect-state"});
-  ASSERT_TRUE(proc.ok());
-  ASSERT_TRUE(PumpUntil(
-      lcm.get(), [&] { return !sink.health.empty(); }, 10.0));
+TEST_F(EstimatorProcess, PerfectStateOnlyOnRequest) {
+  ASSERT_NO_FATAL_FAILURE(Start(kPortPerfect, {"--perfect-state"}));
   state_t truth{};
   truth.utime = 5000;
   truth.seq = 9;
@@ -201,12 +167,12 @@ TEST(EstimatorProcess, PerfectStateOnlyOnRequest) {
   truth.q[2] = 0.4;
   truth.status = state_t::STATUS_GROUND_TRUTH;
   lcm->publish(ch.state_truth, &truth);
-  ASSERT_TRUE(PumpUntil(
+  ASSERT_TRUE(HandleUntil(
       lcm.get(), [&] { return !sink.states.empty(); }, 5.0));
   EXPECT_EQ(sink.states[0].sample_utime, 5000);
   EXPECT_DOUBLE_EQ(sink.states[0].q[2], 0.4);
   EXPECT_EQ(sink.states[0].status, state_t::STATUS_VALID | state_t::STATUS_PERFECT_STATE);
-  EXPECT_EQ(proc.Stop(), 0);
+  EXPECT_EQ(proc->Stop(SIGTERM), 0);
 }
 
 }  // namespace

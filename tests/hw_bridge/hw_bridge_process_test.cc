@@ -4,7 +4,6 @@
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <spawn.h>
-#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -20,6 +19,7 @@
 #include "stewart/model/kinematics.h"
 #include "stewart/node/lcm_handle.h"
 #include "stewart/sensor_t.hpp"
+#include "stewart/test_support/child_process.h"
 
 extern char** environ;
 
@@ -27,40 +27,6 @@ namespace stewart {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-/// A child process, terminated (SIGTERM, then SIGKILL) when it goes out of scope.
-class Child {
- public:
-  explicit Child(std::vector<std::string> args) {
-    std::vector<char*> argv;
-    for (std::string& a : args) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    pid_ = fork();
-    if (pid_ == 0) {
-      // Die with the test, even when it is killed: no stray device on a port.
-      prctl(PR_SET_PDEATHSIG, SIGTERM);
-      execv(argv[0], argv.data());
-      _exit(127);
-    }
-  }
-  ~Child() {
-    if (pid_ <= 0) return;
-    kill(pid_, SIGTERM);
-    for (int i = 0; i < 200; ++i) {
-      if (waitpid(pid_, nullptr, WNOHANG) == pid_) return;
-      std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    }
-    kill(pid_, SIGKILL);
-    waitpid(pid_, nullptr, 0);
-  }
-  Child(const Child&) = delete;
-  Child& operator=(const Child&) = delete;
-  bool started() const { return pid_ > 0; }
-  bool running() const { return pid_ > 0 && waitpid(pid_, nullptr, WNOHANG) == 0; }
-
- private:
-  pid_t pid_ = -1;
-};
 
 class Stack {
  public:
@@ -241,10 +207,11 @@ void ExerciseLink(Stack* stack, bool expect_lost) {
 TEST(HwBridgeProcess, UdpEmulatorEndToEnd) {
   Stack stack(7760);
   const std::string url = stack.config_.lcm.url;
-  Child emulator({HW_EMULATOR_EXE, "--transport", "udp", "--device-port", "17620", "--host-port",
-                  "17621", "--drop-every", "97", "--log-level", "warn"});
-  Child bridge({HW_BRIDGE_EXE, "--lcm-url", url, "--device-port", "17620", "--local-port", "17621",
-                "--log-level", "warn"});
+  test::ChildProcess emulator({HW_EMULATOR_EXE, "--transport", "udp", "--device-port", "17620",
+                               "--host-port", "17621", "--drop-every", "97", "--log-level",
+                               "warn"});
+  test::ChildProcess bridge({HW_BRIDGE_EXE, "--lcm-url", url, "--device-port", "17620",
+                             "--local-port", "17621", "--log-level", "warn"});
   ASSERT_TRUE(emulator.started());
   ASSERT_TRUE(bridge.started());
   stack.Run(0.3, false);  // start-up; the device holds with zero drive meanwhile
@@ -257,15 +224,15 @@ TEST(HwBridgeProcess, SerialOverPtyEndToEnd) {
   Stack stack(7761);
   const std::string url = stack.config_.lcm.url;
   const std::string link = "/tmp/hw_bridge_test_" + std::to_string(getpid()) + ".pty";
-  Child emulator(
+  test::ChildProcess emulator(
       {HW_EMULATOR_EXE, "--transport", "pty", "--pty-link", link, "--log-level", "warn"});
   ASSERT_TRUE(emulator.started());
   for (int i = 0; i < 200 && access(link.c_str(), F_OK) != 0; ++i) {
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
   ASSERT_EQ(access(link.c_str(), F_OK), 0) << "emulator did not create " << link;
-  Child bridge({HW_BRIDGE_EXE, "--lcm-url", url, "--transport", "serial", "--serial-device", link,
-                "--log-level", "warn"});
+  test::ChildProcess bridge({HW_BRIDGE_EXE, "--lcm-url", url, "--transport", "serial",
+                             "--serial-device", link, "--log-level", "warn"});
   ASSERT_TRUE(bridge.started());
   stack.Run(0.3, false);
   ExerciseLink(&stack, false);

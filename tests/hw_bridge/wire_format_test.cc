@@ -41,14 +41,23 @@ TEST(Crc32, StandardCheckValue) {
   EXPECT_EQ(Crc32(text, sizeof(text)), 0xCBF43926U);
 }
 
+/// Encodes `in` with `encode`, checks the frame's size (`payload_size` plus
+/// header and CRC) and decodes it again as one datagram of `type`.
+template <typename Frame>
+void RoundTrip(const Frame& in, std::size_t (*encode)(const Frame&, uint8_t*),
+               std::size_t payload_size, FrameType type, DecodedFrame* out) {
+  std::array<uint8_t, kMaxFrameSize> buf{};
+  const std::size_t n = encode(in, buf.data());
+  EXPECT_EQ(n, kHeaderSize + payload_size + kCrcSize);
+  ASSERT_EQ(DecodeDatagram(buf.data(), n, out), DecodeStatus::kOk);
+  ASSERT_EQ(out->type, type);
+}
+
 TEST(WireFormat, SensorFrameRoundTrip) {
   const SensorFrame in = SampleSensorFrame();
-  std::array<uint8_t, kMaxFrameSize> buf{};
-  const std::size_t n = EncodeSensorFrame(in, buf.data());
-  EXPECT_EQ(n, kHeaderSize + kSensorPayloadSize + kCrcSize);
   DecodedFrame out;
-  ASSERT_EQ(DecodeDatagram(buf.data(), n, &out), DecodeStatus::kOk);
-  ASSERT_EQ(out.type, FrameType::kSensor);
+  ASSERT_NO_FATAL_FAILURE(
+      RoundTrip(in, EncodeSensorFrame, kSensorPayloadSize, FrameType::kSensor, &out));
   const SensorFrame& f = out.sensor;
   EXPECT_EQ(f.seq, in.seq);
   EXPECT_EQ(f.device_time_us, in.device_time_us);
@@ -66,12 +75,9 @@ TEST(WireFormat, SensorFrameRoundTrip) {
 
 TEST(WireFormat, CommandFrameRoundTrip) {
   const CommandFrame in = SampleCommandFrame();
-  std::array<uint8_t, kMaxFrameSize> buf{};
-  const std::size_t n = EncodeCommandFrame(in, buf.data());
-  EXPECT_EQ(n, kHeaderSize + kCommandPayloadSize + kCrcSize);
   DecodedFrame out;
-  ASSERT_EQ(DecodeDatagram(buf.data(), n, &out), DecodeStatus::kOk);
-  ASSERT_EQ(out.type, FrameType::kCommand);
+  ASSERT_NO_FATAL_FAILURE(
+      RoundTrip(in, EncodeCommandFrame, kCommandPayloadSize, FrameType::kCommand, &out));
   EXPECT_EQ(out.command.seq, in.seq);
   EXPECT_EQ(out.command.watchdog_us, in.watchdog_us);
   EXPECT_EQ(out.command.drive, in.drive);

@@ -11,6 +11,7 @@ namespace stewart {
 namespace {
 
 using test::DefaultConfig;
+using test::ForRandomPoses;
 using test::RandomPose;
 using test::RandomVelocity;
 
@@ -29,24 +30,20 @@ TEST(Dynamics, MassMatrixSymmetricPositiveDefinite) {
 
 TEST(Dynamics, HIsTransposedLegJacobian) {
   const auto& p = DefaultConfig().platform;
-  std::mt19937 rng(11);
-  for (int n = 0; n < kStates; ++n) {
-    const Vector6d q = RandomPose(&rng);
-    const DynamicsTerms t = EvaluateDynamics(p, q, RandomVelocity(&rng));
+  ForRandomPoses(11, kStates, [&](const Vector6d& q, std::mt19937* rng) {
+    const DynamicsTerms t = EvaluateDynamics(p, q, RandomVelocity(rng));
     EXPECT_LT((t.H - LegLengthJacobian(p, q).transpose()).cwiseAbs().maxCoeff(), 1e-14);
-  }
+  });
 }
 
 // Bit for bit: plant_sim's root functions take the leg lengths of the last
 // model evaluation in place of InverseKinematics at the same q.
 TEST(Dynamics, LegLengthsAreExactlyInverseKinematics) {
   const auto& p = DefaultConfig().platform;
-  std::mt19937 rng(18);
-  for (int n = 0; n < kStates; ++n) {
-    const Vector6d q = RandomPose(&rng);
-    const DynamicsTerms t = EvaluateDynamics(p, q, RandomVelocity(&rng));
+  ForRandomPoses(18, kStates, [&](const Vector6d& q, std::mt19937* rng) {
+    const DynamicsTerms t = EvaluateDynamics(p, q, RandomVelocity(rng));
     for (int i = 0; i < kNumLegs; ++i) EXPECT_EQ(t.leg_length_m(i), InverseKinematics(p, q)(i));
-  }
+  });
 }
 
 Matrix6d MassMatrix(const PlatformParams& p, const Vector6d& q) {
@@ -66,25 +63,21 @@ Matrix6d MassMatrixRate(const PlatformParams& p, const Vector6d& q, const Vector
 // energy-based CBF's derivative is only right if this holds.
 TEST(Dynamics, PowerBalance) {
   const auto& p = DefaultConfig().platform;
-  std::mt19937 rng(12);
-  for (int n = 0; n < kStates; ++n) {
-    const Vector6d q = RandomPose(&rng);
-    const Vector6d qd = RandomVelocity(&rng);
+  ForRandomPoses(12, kStates, [&](const Vector6d& q, std::mt19937* rng) {
+    const Vector6d qd = RandomVelocity(rng);
     const Matrix6d Mdot = MassMatrixRate(p, q, qd);
     const DynamicsTerms t = EvaluateDynamics(p, q, qd);
     const double scale = std::abs(qd.dot(Mdot * qd)) + 2 * std::abs(qd.dot(t.C_qd)) + 1e-12;
     EXPECT_LT(std::abs(qd.dot(Mdot * qd) - 2.0 * qd.dot(t.C_qd)) / scale, 1e-7);
-  }
+  });
 }
 
 // The whole vector, not only its power: C qd = Mdot qd - 1/2 d/dq (qd^T M qd)
 // (Lagrange's equations).
 TEST(Dynamics, CoriolisVectorMatchesLagrangian) {
   const auto& p = DefaultConfig().platform;
-  std::mt19937 rng(13);
-  for (int n = 0; n < kStates; ++n) {
-    const Vector6d q = RandomPose(&rng);
-    const Vector6d qd = RandomVelocity(&rng);
+  ForRandomPoses(13, kStates, [&](const Vector6d& q, std::mt19937* rng) {
+    const Vector6d qd = RandomVelocity(rng);
     const double h = 1e-6;
     const Matrix6d Mdot = MassMatrixRate(p, q, qd);
     Vector6d dT_dq;
@@ -97,14 +90,12 @@ TEST(Dynamics, CoriolisVectorMatchesLagrangian) {
     const Vector6d expected = Mdot * qd - dT_dq;
     const DynamicsTerms t = EvaluateDynamics(p, q, qd);
     EXPECT_LT((t.C_qd - expected).norm(), 1e-7 * (1.0 + expected.norm())) << q.transpose();
-  }
+  });
 }
 
 TEST(Dynamics, GravityIsGradientOfPotential) {
   const auto& p = DefaultConfig().platform;
-  std::mt19937 rng(14);
-  for (int n = 0; n < kStates; ++n) {
-    const Vector6d q = RandomPose(&rng);
+  ForRandomPoses(14, kStates, [&](const Vector6d& q, std::mt19937*) {
     Vector6d grad;
     const double h = 1e-6;
     for (int j = 0; j < 6; ++j) {
@@ -114,7 +105,7 @@ TEST(Dynamics, GravityIsGradientOfPotential) {
     }
     const DynamicsTerms t = EvaluateDynamics(p, q, Vector6d::Zero());
     EXPECT_LT((t.G - grad).norm(), 1e-7);
-  }
+  });
 }
 
 TEST(Dynamics, InverseOfForwardReturnsForce) {

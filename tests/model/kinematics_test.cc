@@ -12,12 +12,11 @@ namespace stewart {
 namespace {
 
 using test::DefaultConfig;
+using test::ForRandomPoses;
 using test::RandomPose;
 
 TEST(Rotation, EulerRoundTripAndRateMatrix) {
-  std::mt19937 rng(1);
-  for (int n = 0; n < 200; ++n) {
-    const Vector6d q = RandomPose(&rng);
+  ForRandomPoses(1, 200, [&](const Vector6d& q, std::mt19937*) {
     const Vector3d rpy = q.tail<3>();
     EXPECT_LT((EulerFromRotation(RotationFromEuler(rpy)) - rpy).norm(), 1e-12);
     // omega from finite differences of R: Rdot R^T = [omega]x
@@ -32,7 +31,7 @@ TEST(Rotation, EulerRoundTripAndRateMatrix) {
     const Vector3d bias_fd =
         (EulerRateMatrix(rpy + h * rpyd) - EulerRateMatrix(rpy - h * rpyd)) / (2 * h) * rpyd;
     EXPECT_LT((EulerRateBiasAcceleration(rpy, rpyd) - bias_fd).norm(), 1e-8);
-  }
+  });
 }
 
 TEST(Kinematics, HomePoseLegsInsideStroke) {
@@ -83,9 +82,7 @@ TEST(Kinematics, ForwardKinematicsReportsNonConvergence) {
 
 TEST(Kinematics, JacobianEqualsFiniteDifferences) {
   const auto& c = DefaultConfig();
-  std::mt19937 rng(3);
-  for (int n = 0; n < 500; ++n) {
-    const Vector6d q = RandomPose(&rng);
+  ForRandomPoses(3, 500, [&](const Vector6d& q, std::mt19937*) {
     const Matrix6d J = LegLengthJacobian(c.platform, q);
     Matrix6d J_fd;
     const double h = 1e-6;
@@ -96,7 +93,7 @@ TEST(Kinematics, JacobianEqualsFiniteDifferences) {
           (InverseKinematics(c.platform, q + dq) - InverseKinematics(c.platform, q - dq)) / (2 * h);
     }
     EXPECT_LT((J - J_fd).cwiseAbs().maxCoeff(), 1e-8) << q.transpose();
-  }
+  });
 }
 
 TEST(Kinematics, WorkspaceChecks) {

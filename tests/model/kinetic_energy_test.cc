@@ -67,16 +67,14 @@ double KineticEnergyFromBodies(const PlatformParams& p, const Vector6d& q, const
 
 TEST(Dynamics, KineticEnergyMatchesBodyVelocities) {
   const auto& p = test::DefaultConfig().platform;
-  std::mt19937 rng(16);
-  for (int n = 0; n < 500; ++n) {
-    const Vector6d q = test::RandomPose(&rng);
-    const Vector6d qd = test::RandomVelocity(&rng);
+  test::ForRandomPoses(16, 500, [&](const Vector6d& q, std::mt19937* rng) {
+    const Vector6d qd = test::RandomVelocity(rng);
     const double expected = KineticEnergyFromBodies(p, q, qd);
     const double model = KineticEnergy(EvaluateDynamics(p, q, qd), qd);
     // Central differences at h = 1e-6: truncation ~1e-12, round-off ~1e-10
     // relative; a wrong mass or inertia term is a relative error >= 1e-4.
     EXPECT_NEAR(model, expected, 1e-8 * expected) << q.transpose();
-  }
+  });
 }
 
 // Every term counts: dropping any one mass parameter must change the energy

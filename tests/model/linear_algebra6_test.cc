@@ -37,6 +37,12 @@ Vector6d RandomVector(std::mt19937* rng) {
   return v;
 }
 
+// The 2-norm condition number: largest over smallest singular value.
+double ConditionNumber(const Matrix6d& a) {
+  const Eigen::JacobiSVD<Matrix6d> svd(a);
+  return svd.singularValues()(0) / svd.singularValues()(5);
+}
+
 // Backward-stable solvers agree to ~cond * eps.
 void ExpectCholeskyMatchesEigen(const Matrix6d& a, const Vector6d& b, double cond) {
   Cholesky6 chol;
@@ -73,14 +79,10 @@ void ExpectLuMatchesEigen(const Matrix6d& a, const Vector6d& b, double cond) {
 }
 
 TEST(LinearAlgebra6, CholeskyOfTheModelsInertiaMatchesEigen) {
-  std::mt19937 rng(41);
-  for (int n = 0; n < 500; ++n) {
-    const Vector6d q = RandomPose(&rng);
-    const DynamicsTerms t = EvaluateDynamics(DefaultConfig().platform, q, RandomVelocity(&rng));
-    const Eigen::JacobiSVD<Matrix6d> svd(t.M);
-    const double cond = svd.singularValues()(0) / svd.singularValues()(5);
-    ExpectCholeskyMatchesEigen(t.M, RandomVector(&rng), cond);
-  }
+  ForRandomPoses(41, 500, [&](const Vector6d& q, std::mt19937* rng) {
+    const DynamicsTerms t = EvaluateDynamics(DefaultConfig().platform, q, RandomVelocity(rng));
+    ExpectCholeskyMatchesEigen(t.M, RandomVector(rng), ConditionNumber(t.M));
+  });
 }
 
 TEST(LinearAlgebra6, CholeskyOfRandomMatricesMatchesEigen) {
@@ -113,14 +115,10 @@ TEST(LinearAlgebra6, CholeskyReportsWhatIsNotPositiveDefinite) {
 }
 
 TEST(LinearAlgebra6, PartialPivotSolveOfTheModelsHMatchesEigen) {
-  std::mt19937 rng(47);
-  for (int n = 0; n < 500; ++n) {
-    const Vector6d q = RandomPose(&rng);
+  ForRandomPoses(47, 500, [&](const Vector6d& q, std::mt19937* rng) {
     const DynamicsTerms t = EvaluateDynamics(DefaultConfig().platform, q, Vector6d::Zero());
-    const Eigen::JacobiSVD<Matrix6d> svd(t.H);
-    const double cond = svd.singularValues()(0) / svd.singularValues()(5);
-    ExpectLuMatchesEigen(t.H, RandomVector(&rng), cond);
-  }
+    ExpectLuMatchesEigen(t.H, RandomVector(rng), ConditionNumber(t.H));
+  });
 }
 
 TEST(LinearAlgebra6, PartialPivotSolveOfRandomMatricesMatchesEigen) {

@@ -1,14 +1,11 @@
 #include "test_states.h"
 
-#include "stewart/config/config_loader.h"
+#include "stewart/config/default_config.h"
 #include "stewart/model/kinematics.h"
 
 namespace stewart::test {
 
-const StackConfig& DefaultConfig() {
-  static const StackConfig config = LoadStackConfig(DefaultConfigPath());
-  return config;
-}
+const StackConfig& DefaultConfig() { return DefaultStackConfig(); }
 
 Vector6d RandomPose(std::mt19937* rng) {
   std::uniform_real_distribution<double> trans(-0.08, 0.08);

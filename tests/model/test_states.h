@@ -13,4 +13,15 @@ const StackConfig& DefaultConfig();
 Vector6d RandomPose(std::mt19937* rng);
 Vector6d RandomVelocity(std::mt19937* rng);
 
+/// Calls `f(q, rng)` for `n` random poses q drawn from a generator seeded
+/// with `seed`; `f` may draw more from `rng` after each pose.
+template <typename F>
+void ForRandomPoses(unsigned seed, int n, F f) {
+  std::mt19937 rng(seed);
+  for (int k = 0; k < n; ++k) {
+    const Vector6d q = RandomPose(&rng);
+    f(q, &rng);
+  }
+}
+
 }  // namespace stewart::test

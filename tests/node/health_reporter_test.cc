@@ -1,30 +1,22 @@
+#include "stewart/node/health_reporter.h"
+
 #include <gtest/gtest.h>
 
 #include <chrono>
 #include <thread>
 
-#include "stewart/node/health_reporter.h"
 #include "stewart/node/lcm_handle.h"
+#include "stewart/test_support/lcm_messages.h"
 
 namespace stewart {
 namespace {
 
 constexpr int kPort = 7800;  // this test's private LCM port
 
-class HealthSink {
- public:
-  void OnHealth(const lcm::ReceiveBuffer*, const std::string&, const health_t* msg) {
-    last = *msg;
-    ++received;
-  }
-  health_t last;
-  int received = 0;
-};
-
 TEST(HealthReporter, CountsRejectionsAndPublishes) {
   auto lcm = MakeLcm(PrivateLcmUrl(kPort));
-  HealthSink sink;
-  lcm->subscribe("TEST_HEALTH", &HealthSink::OnHealth, &sink);
+  test::Inbox<health_t> sink;
+  lcm->subscribe("TEST_HEALTH", &test::Inbox<health_t>::On, &sink);
 
   HealthReporter health("estimator", "TEST_HEALTH", 1000.0);
   health.CountIn();
@@ -42,22 +34,21 @@ TEST(HealthReporter, CountsRejectionsAndPublishes) {
 
   ASSERT_TRUE(health.MaybePublish(lcm.get(), /*force=*/true));
   EXPECT_FALSE(health.MaybePublish(lcm.get()));  // period not elapsed
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(3);
-  while (sink.received == 0 && std::chrono::steady_clock::now() < deadline) {
-    lcm->handleTimeout(100);
-  }
-  ASSERT_EQ(sink.received, 1);
-  EXPECT_EQ(sink.last.name, "estimator");
-  EXPECT_EQ(sink.last.utime, 5000);
-  EXPECT_EQ(sink.last.sample_utime, 4000);
-  EXPECT_EQ(sink.last.messages_in, 2);
-  EXPECT_EQ(sink.last.messages_out, 1);
-  EXPECT_EQ(sink.last.rejected_inputs, 3);
-  EXPECT_EQ(sink.last.state, +health_t::STATE_DEGRADED);  // + : lcm-gen constants have no definition
-  EXPECT_EQ(sink.last.last_error, "stale");
-  ASSERT_EQ(sink.last.num_counters, 3);
-  EXPECT_EQ(sink.last.counter_names[0], "rejected_nan");
-  EXPECT_EQ(sink.last.counter_values[0], 2);
+  test::HandleUntil(
+      lcm.get(), [&] { return !sink.received.empty(); }, 3.0, 100);
+  ASSERT_EQ(sink.received.size(), 1u);
+  const health_t& last = sink.received.back();
+  EXPECT_EQ(last.name, "estimator");
+  EXPECT_EQ(last.utime, 5000);
+  EXPECT_EQ(last.sample_utime, 4000);
+  EXPECT_EQ(last.messages_in, 2);
+  EXPECT_EQ(last.messages_out, 1);
+  EXPECT_EQ(last.rejected_inputs, 3);
+  EXPECT_EQ(last.state, +health_t::STATE_DEGRADED);  // + : lcm-gen constants have no definition
+  EXPECT_EQ(last.last_error, "stale");
+  ASSERT_EQ(last.num_counters, 3);
+  EXPECT_EQ(last.counter_names[0], "rejected_nan");
+  EXPECT_EQ(last.counter_values[0], 2);
 }
 
 TEST(LcmHandle, BadUrlGivesClearError) {

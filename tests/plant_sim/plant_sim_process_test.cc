@@ -1,7 +1,5 @@
 // The real plant_sim process over LCM (private URLs, ports 7700-7719, ttl=0).
 #include <gtest/gtest.h>
-#include <spawn.h>
-#include <sys/wait.h>
 
 #include <chrono>
 #include <fstream>
@@ -20,56 +18,13 @@
 #include "stewart/node/lcm_handle.h"
 #include "stewart/sensor_t.hpp"
 #include "stewart/state_t.hpp"
-
-extern char** environ;
+#include "stewart/test_support/child_process.h"
 
 namespace stewart {
 namespace {
 
 using Clock = std::chrono::steady_clock;
 using test::Config;
-
-class Process {
- public:
-  explicit Process(std::vector<std::string> args) {
-    args.insert(args.begin(), PLANT_SIM_BIN);
-    std::vector<char*> argv;
-    for (auto& a : args) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    if (posix_spawn(&pid_, PLANT_SIM_BIN, nullptr, nullptr, argv.data(), environ) != 0) pid_ = -1;
-  }
-  ~Process() {
-    if (pid_ > 0 && !exited_) {
-      kill(pid_, SIGTERM);
-      Wait();
-    }
-  }
-  bool running() const { return pid_ > 0 && !exited_; }
-  /// Non-blocking; true once the process has exited.
-  bool Poll() {
-    if (exited_) return true;
-    int status = 0;
-    if (waitpid(pid_, &status, WNOHANG) == pid_) {
-      exited_ = true;
-      exit_code_ = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    }
-    return exited_;
-  }
-  int Wait() {
-    int status = 0;
-    if (!exited_ && waitpid(pid_, &status, 0) == pid_) {
-      exited_ = true;
-      exit_code_ = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    }
-    return exit_code_;
-  }
-  int exit_code() const { return exit_code_; }
-
- private:
-  pid_t pid_ = -1;
-  bool exited_ = false;
-  int exit_code_ = -1;
-};
 
 // Records what plant_sim publishes and, if asked, answers every sensor
 // sample with a leg-space P controller around the holding force.
@@ -90,9 +45,9 @@ class Stack {
     const auto end = Clock::now() + std::chrono::duration<double>(seconds);
     while (Clock::now() < end) lcm_->handleTimeout(5);
   }
-  void SpinUntilExit(Process* p, double max_seconds) {
+  void SpinUntilExit(test::ChildProcess* p, double max_seconds) {
     const auto end = Clock::now() + std::chrono::duration<double>(max_seconds);
-    while (Clock::now() < end && !p->Poll()) lcm_->handleTimeout(5);
+    while (Clock::now() < end && p->running()) lcm_->handleTimeout(5);
     while (lcm_->handleTimeout(20) > 0) {
     }
   }
@@ -142,7 +97,8 @@ class Stack {
 TEST(PlantSimProcess, RealTimePublishesAndReactsToCommands) {
   const std::string url = PrivateLcmUrl(7700);
   Stack stack(url, false);
-  Process sim({"--lcm-url", url, "--mode", "realtime", "--duration", "3", "--log-level", "warn"});
+  test::ChildProcess sim({PLANT_SIM_BIN, "--lcm-url", url, "--mode", "realtime", "--duration", "3",
+                          "--log-level", "warn"});
   ASSERT_TRUE(sim.running());
   stack.Spin(0.5);  // no commands: actuators off, legs locked
   ASSERT_GT(stack.sensors.size(), 100u);
@@ -179,8 +135,8 @@ TEST(PlantSimProcess, RealTimePublishesAndReactsToCommands) {
 std::vector<std::vector<uint8_t>> LockstepRun(int port) {
   const std::string url = PrivateLcmUrl(port);
   Stack stack(url, true);
-  Process sim({"--lcm-url", url, "--mode", "lockstep", "--duration", "0.5", "--seed", "11",
-               "--log-level", "warn"});
+  test::ChildProcess sim({PLANT_SIM_BIN, "--lcm-url", url, "--mode", "lockstep", "--duration",
+                          "0.5", "--seed", "11", "--log-level", "warn"});
   EXPECT_TRUE(sim.running());
   stack.SpinUntilExit(&sim, 15.0);
   EXPECT_EQ(sim.Wait(), 0);
@@ -206,14 +162,14 @@ TEST(PlantSimProcess, LockstepGivesByteIdenticalGroundTruth) {
 double SinkAfter(int port, const std::string& truth_path, double duration_s) {
   const std::string url = PrivateLcmUrl(port);
   Stack stack(url, true, /*hold_only=*/true);
-  std::vector<std::string> args = {"--lcm-url",   url,          "--mode",
-                                   "lockstep",    "--duration", std::to_string(duration_s),
-                                   "--log-level", "warn"};
+  std::vector<std::string> args = {PLANT_SIM_BIN, "--lcm-url",  url,
+                                   "--mode",      "lockstep",   "--duration",
+                                   std::to_string(duration_s), "--log-level", "warn"};
   if (!truth_path.empty()) {
     args.push_back("--truth");
     args.push_back(truth_path);
   }
-  Process sim(args);
+  test::ChildProcess sim(args);
   EXPECT_TRUE(sim.running());
   stack.SpinUntilExit(&sim, 15.0);
   EXPECT_EQ(sim.Wait(), 0);
@@ -266,8 +222,8 @@ TEST(PlantSimProcess, LockstepTimeoutExitsNamingWhatItWaitedFor) {
   std::ofstream(path) << yaml;
   const std::string url = PrivateLcmUrl(7703);
   Stack stack(url, false);
-  Process sim({"--config", path, "--lcm-url", url, "--mode", "lockstep", "--duration", "1",
-               "--log-level", "warn"});
+  test::ChildProcess sim({PLANT_SIM_BIN, "--config", path, "--lcm-url", url, "--mode", "lockstep",
+                          "--duration", "1", "--log-level", "warn"});
   stack.SpinUntilExit(&sim, 10.0);
   EXPECT_EQ(sim.Wait(), 3);
   ASSERT_FALSE(stack.health.empty());

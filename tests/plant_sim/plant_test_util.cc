@@ -2,10 +2,7 @@
 
 namespace stewart::test {
 
-const StackConfig& Config() {
-  static const StackConfig config = LoadStackConfig(DefaultConfigPath());
-  return config;
-}
+const StackConfig& Config() { return DefaultStackConfig(); }
 
 PlantModel DefaultModel() { return PlantModel{Config().platform, Config().actuators}; }
 

@@ -2,7 +2,7 @@
 // Shared set-up of the plant_sim tests.
 #include <string>
 
-#include "stewart/config/config_loader.h"
+#include "stewart/config/default_config.h"
 #include "stewart/plant_sim/plant.h"
 
 namespace stewart::test {

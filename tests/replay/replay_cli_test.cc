@@ -1,6 +1,6 @@
 // stewart_replay on inputs made here: bad input exits 2 with a message that
-// names the problem; a synthetic run whose safe commands were computed with
-// the filter library replays bit-identically (fallbacks counted apart), and
+// names the problem; a synthetic run whose safe commands the safety process's
+// own class made replays bit-identically (fallbacks counted apart), and
 // a one-ulp change of one recorded command makes --expect-identical exit 1;
 // messages the logger lost are found and left out; the controller's clock
 // is recovered when the log lacks its first commands.
@@ -19,12 +19,15 @@
 #include <string>
 #include <vector>
 
+#include "stewart/common/health_counters.h"
 #include "stewart/config/config_loader.h"
 #include "stewart/config/scenario_loader.h"
 #include "stewart/controller/controller.h"
 #include "stewart/force_command_t.hpp"
+#include "stewart/node/signal_messages.h"
 #include "stewart/safety/diagnostics_lcm.h"
-#include "stewart/safety/safety_filter.h"
+#include "stewart/safety/safety_process.h"
+#include "stewart/safety_diagnostics_t.hpp"
 #include "stewart/state_t.hpp"
 #include "stewart/test_support/lcm_messages.h"
 
@@ -56,8 +59,12 @@ nlohmann::json ReadJson(const std::string& path) {
 }
 
 constexpr int kSamples = 200;
-constexpr int kInitializing = 5;   // first samples: estimator initialising -> node fallback
-constexpr int kStaleSample = 100;  // answered by the watchdog's fallback before its nominal
+constexpr int kInitializing = 5;  // first samples: estimator initialising -> node fallback
+// The estimates pause before this sample (the sensor stream stalled) longer
+// than safety.stale_age_s: the watchdog, judged in state time, answers it with
+// a fallback before its nominal command arrives.
+constexpr int kStaleSample = 180;
+constexpr int64_t kPauseUs = 25'000;
 
 class ReplayCli : public ::testing::Test {
  protected:
@@ -75,13 +82,17 @@ class ReplayCli : public ::testing::Test {
     fs::remove_all(root_, ignored);
   }
 
-  /// A run folder as launch.sh makes it, with a log written here: the safe
-  /// commands as the safety node computes them (closed form). With
+  /// A run folder as launch.sh makes it, with a log written here: estimates
+  /// and nominal commands fed to the safety process's class as the node
+  /// feeds it (closed form), its safe commands and diagnostics as the node
+  /// publishes them, each in the order the logger would receive it. With
   /// `tamper_sample` >= 0 that sample's recorded force 0 is one ulp off;
   /// samples [drop_from, drop_from + drop_count) are left out of the log, as
-  /// lcm-logger loses a burst.
+  /// lcm-logger loses a burst (the process still had them); with
+  /// `tamper_case_sample` >= 0 that sample's recorded diagnostics name
+  /// another case.
   std::string MakeRun(const std::string& name, int tamper_sample = -1, int drop_from = -1,
-                      int drop_count = 0) {
+                      int drop_count = 0, int tamper_case_sample = -1) {
     const std::string run = root_ + "/" + name;
     fs::create_directories(run);
     const std::string config_path = std::string(STEWART_SOURCE_DIR) + "/config/platform.yaml";
@@ -89,18 +100,29 @@ class ReplayCli : public ::testing::Test {
     std::ofstream(run + "/run.yaml") << "variant: closed_form\n";
     StackConfig config = LoadStackConfig(config_path);
     config.safety.variant = SafetyVariant::kClosedForm;
-    safety::SafetyFilter filter(config.platform, config.safety, config.actuators);
+    HealthCounters counters("safety");
+    safety::SafetyProcess process(config.platform, config.safety, config.actuators, nullptr,
+                                  &counters);
     const ChannelNames& ch = config.lcm.channels;
 
     lcm::LogFile log(run + "/log.lcm", "w");
     EXPECT_TRUE(log.good());
-    safety::SafetyDiagnostics d;
-    safety_diagnostics_t diag{};
     int64_t timestamp = 1'000'000;
+    auto publish = [&](const safety::SafetyOutput& out, int k, bool dropped) {
+      force_command_t safe{};
+      ToMessage(out.command, &safe);
+      if (k == tamper_sample) safe.force_n[0] = std::nextafter(safe.force_n[0], 1e9);
+      safety_diagnostics_t diag{};
+      safety::FillDiagnosticsMessage(process.filter(), out, &diag);
+      if (k == tamper_case_sample) diag.active_case = diag.active_case == 0 ? 1 : 0;
+      if (dropped) return;
+      test::AppendToLog(&log, ch.command_safe, safe, timestamp++);
+      test::AppendToLog(&log, ch.safety_diagnostics, diag, timestamp++);
+    };
     int64_t nominal_seq = 0;
     for (int k = 0; k < kSamples; ++k) {
       const bool dropped = k >= drop_from && k < drop_from + drop_count;
-      const int64_t utime = 1000 * (k + 1);
+      const int64_t utime = 1000 * (k + 1) + (k >= kStaleSample ? kPauseUs : 0);
       const double t = 1e-3 * k;
       state_t state{};
       state.utime = state.sample_utime = utime;
@@ -112,36 +134,30 @@ class ReplayCli : public ::testing::Test {
       state.status = k < kInitializing ? int32_t{state_t::STATUS_INITIALIZING}
                                        : int32_t{state_t::STATUS_VALID};
       if (!dropped) test::AppendToLog(&log, ch.state_estimate, state, timestamp++);
+      safety::SafetyOutput out;
+      if (process.OnState(FromMessage(state), &out)) publish(out, k, dropped);
+      if (k < kInitializing) continue;  // the controller waits for a valid estimate
 
       force_command_t nominal{};
       nominal.utime = nominal.sample_utime = utime;
-      if (k >= kInitializing) nominal.seq = nominal_seq++;
+      nominal.seq = nominal_seq++;
       for (int i = 0; i < 6; ++i) nominal.force_n[i] = 1.5 + 0.3 * std::sin(t + i);
-      force_command_t safe{};
-      safe.utime = safe.sample_utime = utime;
-      safe.seq = k;
-      Vector6d f;
-      if (k < kInitializing || k == kStaleSample) {
-        f = filter.SafeStopCommand(FromArrayOf(state.q), FromArrayOf(state.qd), &d);
-        safe.flags = d.flags | (k < kInitializing ? int32_t{force_command_t::FLAG_INVALID_INPUT}
-                                                  : int32_t{force_command_t::FLAG_STALE_INPUT});
-      } else {
-        f = filter.Step(FromArrayOf(state.q), FromArrayOf(state.qd), FromArrayOf(nominal.force_n),
-                        &d);
-        safe.flags = d.flags;
-      }
-      for (int i = 0; i < 6; ++i) safe.force_n[i] = f(i);
-      if (k == tamper_sample) safe.force_n[0] = std::nextafter(safe.force_n[0], 1e9);
-      safety::FillDiagnosticsMessage(filter, d, &diag);
-      diag.utime = diag.sample_utime = utime;
-      diag.seq = k;
-      if (dropped) continue;
-      if (k == kStaleSample) test::AppendToLog(&log, ch.command_safe, safe, timestamp++);
-      if (k >= kInitializing) test::AppendToLog(&log, ch.command_nominal, nominal, timestamp++);
-      if (k != kStaleSample) test::AppendToLog(&log, ch.command_safe, safe, timestamp++);
-      test::AppendToLog(&log, ch.safety_diagnostics, diag, timestamp++);
+      if (!dropped) test::AppendToLog(&log, ch.command_nominal, nominal, timestamp++);
+      if (process.OnNominal(FromMessage(nominal), &out)) publish(out, k, dropped);
     }
+    // The process made what the assertions below count.
+    EXPECT_EQ(counters.counter("fallback_commands"), kInitializing + 1);
+    EXPECT_EQ(counters.counter("rejected_nominal_already_answered"), 1);
     return run;
+  }
+
+  /// stewart_replay on `run` with `args` and --json: the JSON it wrote (null
+  /// if none); its exit code and output in `*result`.
+  nlohmann::json ReplayJson(const std::string& run, const std::string& args,
+                            CommandResult* result) {
+    const std::string json_path = root_ + "/replay.json";
+    *result = RunReplay(run + " " + args + " --json " + json_path);
+    return fs::exists(json_path) ? ReadJson(json_path) : nlohmann::json();
   }
 
   static Vector6d FromArrayOf(const double (&a)[6]) { return Eigen::Map<const Vector6d>(a); }
@@ -189,10 +205,10 @@ TEST_F(ReplayCli, ControllerClockRecoveredWhenTheLogLacksTheStart) {
       test::AppendToLog(&log, config.lcm.channels.command_nominal, nominal, 1000 + k);
     }
   }
-  const std::string json_path = root_ + "/replay.json";
-  const CommandResult r = RunReplay(run + " --controller --expect-identical --json " + json_path);
+  CommandResult r;
+  const nlohmann::json j = ReplayJson(run, "--controller --expect-identical", &r);
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  const nlohmann::json c = ReadJson(json_path).at("controller");
+  const nlohmann::json& c = j.at("controller");
   EXPECT_TRUE(c.at("time_origin_inferred").get<bool>());
   EXPECT_EQ(c.at("time_origin_utime"), 1000);
   EXPECT_EQ(c.at("compared"), kStates - kLost);
@@ -235,10 +251,9 @@ TEST_F(ReplayCli, BadFlagsExitTwo) {
 
 TEST_F(ReplayCli, SyntheticRunReplaysBitIdentically) {
   const std::string run = MakeRun("run");
-  const std::string json_path = root_ + "/replay.json";
-  const CommandResult r = RunReplay(run + " --expect-identical --json " + json_path);
+  CommandResult r;
+  const nlohmann::json j = ReplayJson(run, "--expect-identical", &r);
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  const nlohmann::json j = ReadJson(json_path);
   const nlohmann::json& s = j.at("safety");
   EXPECT_EQ(s.at("variant"), "closed_form");
   EXPECT_EQ(s.at("variant_source"), "run.yaml");
@@ -261,10 +276,9 @@ TEST_F(ReplayCli, SyntheticRunReplaysBitIdentically) {
 TEST_F(ReplayCli, MessagesLostByTheLoggerAreFoundAndNotCompared) {
   constexpr int kDropFrom = 120, kDropCount = 7;
   const std::string run = MakeRun("run", -1, kDropFrom, kDropCount);
-  const std::string json_path = root_ + "/replay.json";
-  const CommandResult r = RunReplay(run + " --expect-identical --json " + json_path);
+  CommandResult r;
+  const nlohmann::json j = ReplayJson(run, "--expect-identical", &r);
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  const nlohmann::json j = ReadJson(json_path);
   const StackConfig config = LoadStackConfig(run + "/config.yaml");
   for (const std::string& channel :
        {config.lcm.channels.state_estimate, config.lcm.channels.command_nominal,
@@ -284,13 +298,42 @@ TEST_F(ReplayCli, MessagesLostByTheLoggerAreFoundAndNotCompared) {
       << r.output;
 }
 
+// The replayed diagnostics are compared too: one recorded case changed makes
+// its step differ although the command is bit-identical.
+TEST_F(ReplayCli, DifferentRecordedDiagnosticsFailExpectIdentical) {
+  CommandResult r;
+  const nlohmann::json j = ReplayJson(MakeRun("run", -1, -1, 0, 150), "--expect-identical", &r);
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  const nlohmann::json& s = j.at("safety");
+  EXPECT_EQ(s.at("diagnostics_differ"), 1);
+  EXPECT_EQ(s.at("flags_differ"), 0);
+  EXPECT_EQ(s.at("max_abs_diff_n"), 0.0);
+  EXPECT_EQ(s.at("identical").get<long>(), s.at("compared").get<long>() - 1);
+}
+
+// A burst lost by the logger longer than safety.stale_age_s: the replayed
+// watchdog fires at the first estimate after it (the live process had the
+// nominal commands the log lacks); that fallback is counted, not compared.
+TEST_F(ReplayCli, WatchdogWhereTheLogLacksNominalCommandsIsNotCompared) {
+  constexpr int kDropCount = 30;
+  CommandResult r;
+  const nlohmann::json j =
+      ReplayJson(MakeRun("run", -1, 130, kDropCount), "--expect-identical", &r);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const nlohmann::json& s = j.at("safety");
+  EXPECT_EQ(s.at("log_gap"), 1);
+  EXPECT_EQ(s.at("compared"), kSamples - kInitializing - 1 - kDropCount - 1);
+  EXPECT_EQ(s.at("identical"), s.at("compared"));
+  EXPECT_EQ(s.at("fallback").at("identical"), kInitializing + 1);
+  EXPECT_NE(r.output.find("1 watchdog fallbacks of the replay"), std::string::npos) << r.output;
+}
+
 TEST_F(ReplayCli, OneUlpDifferenceFailsExpectIdentical) {
   constexpr int kTampered = 150;
   const std::string run = MakeRun("run", kTampered);
-  const std::string json_path = root_ + "/replay.json";
-  const CommandResult r = RunReplay(run + " --expect-identical --json " + json_path);
+  CommandResult r;
+  const nlohmann::json j = ReplayJson(run, "--expect-identical", &r);
   EXPECT_EQ(r.exit_code, 1) << r.output;
-  const nlohmann::json j = ReadJson(json_path);
   const nlohmann::json& s = j.at("safety");
   EXPECT_EQ(s.at("identical").get<long>(), s.at("compared").get<long>() - 1);
   EXPECT_GT(s.at("max_abs_diff_n").get<double>(), 0.0);

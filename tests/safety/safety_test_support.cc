@@ -5,15 +5,12 @@
 #include <algorithm>
 #include <cmath>
 
-#include "stewart/config/config_loader.h"
+#include "stewart/config/default_config.h"
 #include "stewart/model/kinematics.h"
 
 namespace stewart::safety::test {
 
-const StackConfig& DefaultConfig() {
-  static const StackConfig config = LoadStackConfig(DefaultConfigPath());
-  return config;
-}
+const StackConfig& DefaultConfig() { return DefaultStackConfig(); }
 
 SafetyConfig RichSafetyConfig() {
   SafetyConfig s = DefaultConfig().safety;

@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "stewart/config/config_loader.h"
+#include "stewart/config/default_config.h"
 #include "stewart/model/dynamics.h"
 #include "stewart/safety/clp_reference_qp.h"
 #include "stewart/safety/diagnostics_lcm.h"
@@ -23,11 +23,6 @@
 namespace stewart::safety {
 namespace {
 
-const StackConfig& Config() {
-  static const StackConfig config = LoadStackConfig(DefaultConfigPath());
-  return config;
-}
-
 // A state near the z velocity limit moving up, with a nominal force that
 // pushes further: the filter acts (velocity case).
 struct Step {
@@ -35,9 +30,9 @@ struct Step {
 };
 Step ActiveStep() {
   Step s;
-  s.q = Config().home_pose;
+  s.q = DefaultStackConfig().home_pose;
   s.qd << 0.0, 0.0, 0.0095, 0.0, 0.0, 0.0;
-  const DynamicsTerms t = EvaluateDynamics(Config().platform, s.q, s.qd);
+  const DynamicsTerms t = EvaluateDynamics(DefaultStackConfig().platform, s.q, s.qd);
   Vector6d qdd;
   qdd << 0.0, 0.0, 2.0, 0.0, 0.0, 0.0;
   s.f_des = InverseDynamics(t, qdd);
@@ -45,7 +40,8 @@ Step ActiveStep() {
 }
 
 TEST(DiagnosticsMessage, CarriesEveryFilterQuantity) {
-  SafetyFilter filter(Config().platform, Config().safety, Config().actuators);
+  SafetyFilter filter(DefaultStackConfig().platform, DefaultStackConfig().safety,
+                      DefaultStackConfig().actuators);
   const Step s = ActiveStep();
   SafetyDiagnostics d;
   const Vector6d f = filter.Step(s.q, s.qd, s.f_des, &d);
@@ -86,7 +82,7 @@ TEST(DiagnosticsMessage, CarriesEveryFilterQuantity) {
   EXPECT_EQ(msg.compute_ns, d.compute_ns);
   // Recheck from the message alone plus the model: F* - F_des is
   // W^-1 (mu_p g_p + mu_v g_v) in the acceleration metric.
-  const DynamicsTerms t = EvaluateDynamics(Config().platform, s.q, s.qd);
+  const DynamicsTerms t = EvaluateDynamics(DefaultStackConfig().platform, s.q, s.qd);
   const Matrix6d w = t.H.transpose() * t.M.inverse() * t.H;
   Vector6d g_p, g_v, f_des, f_safe;
   for (int i = 0; i < 6; ++i) {
@@ -102,9 +98,9 @@ TEST(DiagnosticsMessage, CarriesEveryFilterQuantity) {
 }
 
 TEST(DiagnosticsMessage, UncomposedCarriesEachBarriersMultiplier) {
-  SafetyConfig config = Config().safety;
+  SafetyConfig config = DefaultStackConfig().safety;
   config.variant = SafetyVariant::kUncomposed;
-  SafetyFilter filter(Config().platform, config, Config().actuators);
+  SafetyFilter filter(DefaultStackConfig().platform, config, DefaultStackConfig().actuators);
   const Step s = ActiveStep();
   SafetyDiagnostics d;
   filter.Step(s.q, s.qd, s.f_des, &d);
@@ -133,13 +129,14 @@ TEST(DiagnosticsMessage, UncomposedCarriesEachBarriersMultiplier) {
 TEST(DiagnosticsMessage, ComputeNsIsTheTimeOfTheFullStep) {
   // Step reads the clock once around the model terms and the filter;
   // StepWithTerms (terms given, e.g. the benches and tests) is not timed.
-  SafetyFilter filter(Config().platform, Config().safety, Config().actuators);
+  SafetyFilter filter(DefaultStackConfig().platform, DefaultStackConfig().safety,
+                      DefaultStackConfig().actuators);
   const Step s = ActiveStep();
   SafetyDiagnostics d;
   filter.Step(s.q, s.qd, s.f_des, &d);
   EXPECT_GT(d.compute_ns, 0);
   EXPECT_LT(d.compute_ns, 1000000000);
-  const DynamicsTerms t = EvaluateDynamics(Config().platform, s.q, s.qd);
+  const DynamicsTerms t = EvaluateDynamics(DefaultStackConfig().platform, s.q, s.qd);
   filter.StepWithTerms(t, s.q, s.qd, s.f_des, &d);
   EXPECT_EQ(d.compute_ns, 0);
 }
@@ -168,10 +165,11 @@ TEST(SafetyTool, PrintsWhatTheLibraryComputesForEveryVariant) {
   for (const char* variant : {"closed_form", "paper", "qp", "uncomposed"}) {
     const std::string out = RunTool(Line(s).dump() + "\n", std::string("--variant ") + variant);
     const nlohmann::json j = nlohmann::json::parse(out);
-    SafetyConfig config = Config().safety;
+    SafetyConfig config = DefaultStackConfig().safety;
     config.variant = ParseSafetyVariant(variant);
     ClpReferenceQp clp;
-    SafetyFilter filter(Config().platform, config, Config().actuators, &clp);
+    SafetyFilter filter(DefaultStackConfig().platform, config, DefaultStackConfig().actuators,
+                        &clp);
     SafetyDiagnostics d;
     const Vector6d f = filter.Step(s.q, s.qd, s.f_des, &d);
     EXPECT_EQ(j.at("variant"), variant);

@@ -2,9 +2,6 @@
 // answered with the same sample_utime; when nominal commands stop (the
 // controller died), each new state is answered with the flagged fallback.
 #include <gtest/gtest.h>
-#include <signal.h>
-#include <spawn.h>
-#include <sys/wait.h>
 
 #include <chrono>
 #include <string>
@@ -16,40 +13,13 @@
 #include "stewart/node/eigen_msg.h"
 #include "stewart/node/lcm_handle.h"
 #include "stewart/state_t.hpp"
-
-extern char** environ;
+#include "stewart/test_support/child_process.h"
+#include "stewart/test_support/lcm_messages.h"
 
 namespace stewart {
 namespace {
 
 constexpr int kPort = 7810;  // this test's private LCM port
-
-class SafeSink {
- public:
-  void OnSafe(const lcm::ReceiveBuffer*, const std::string&, const force_command_t* msg) {
-    received.push_back(*msg);
-  }
-  std::vector<force_command_t> received;
-};
-
-class SafetyProcess {
- public:
-  explicit SafetyProcess(const std::string& url) {
-    std::vector<std::string> args = {SAFETY_PATH, "--lcm-url", url, "--log-level", "warn"};
-    std::vector<char*> argv;
-    for (auto& a : args) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    EXPECT_EQ(posix_spawn(&pid_, SAFETY_PATH, nullptr, nullptr, argv.data(), environ), 0);
-  }
-  ~SafetyProcess() {
-    kill(pid_, SIGTERM);
-    int status = 0;
-    waitpid(pid_, &status, 0);
-  }
-
- private:
-  pid_t pid_ = 0;
-};
 
 state_t MakeState(int64_t utime, const Vector6d& q) {
   state_t s{};
@@ -61,21 +31,19 @@ state_t MakeState(int64_t utime, const Vector6d& q) {
   return s;
 }
 
-bool WaitFor(lcm::LCM* lcm, const SafeSink& sink, std::size_t count) {
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(5);
-  while (sink.received.size() < count && std::chrono::steady_clock::now() < deadline) {
-    lcm->handleTimeout(50);
-  }
-  return sink.received.size() >= count;
+bool WaitFor(lcm::LCM* lcm, const test::Inbox<force_command_t>& sink, std::size_t count) {
+  return test::HandleUntil(
+      lcm, [&] { return sink.received.size() >= count; }, 5.0, 50);
 }
 
 TEST(SafetyProcess, FiltersNominalAndFallsBackWhenControllerStops) {
   const StackConfig config = LoadStackConfig(DefaultConfigPath());
   const std::string url = PrivateLcmUrl(kPort);
   auto lcm = MakeLcm(url);
-  SafeSink sink;
-  lcm->subscribe(config.lcm.channels.command_safe, &SafeSink::OnSafe, &sink);
-  SafetyProcess process(url);
+  test::Inbox<force_command_t> sink;
+  lcm->subscribe(config.lcm.channels.command_safe, &test::Inbox<force_command_t>::On, &sink);
+  test::ChildProcess process({SAFETY_PATH, "--lcm-url", url, "--log-level", "warn"});
+  EXPECT_TRUE(process.started());
   // Give the process time to subscribe: resend the first state until the
   // first answer (the fallback: no nominal command has arrived yet).
   int64_t utime = 1'000'000;

@@ -6,8 +6,6 @@
 // left to its own devices. LCM port 7822 (this folder owns 7820-7829).
 #include <gtest/gtest.h>
 #include <signal.h>
-#include <spawn.h>
-#include <sys/wait.h>
 
 #include <algorithm>
 #include <chrono>
@@ -18,37 +16,12 @@
 #include "stewart/config/config_loader.h"
 #include "stewart/force_command_t.hpp"
 #include "stewart/node/lcm_handle.h"
-
-extern char** environ;
+#include "stewart/test_support/child_process.h"
 
 namespace stewart {
 namespace {
 
 constexpr int kPort = 7822;
-
-class Child {
- public:
-  Child(const std::string& name, std::vector<std::string> args) : name_(name) {
-    std::vector<char*> argv;
-    for (auto& a : args) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    ok_ = posix_spawn(&pid_, args[0].c_str(), nullptr, nullptr, argv.data(), environ) == 0;
-  }
-  ~Child() { Stop(SIGTERM); }
-  void Stop(int signal) {
-    if (pid_ <= 0) return;
-    kill(pid_, signal);
-    int status = 0;
-    waitpid(pid_, &status, 0);
-    pid_ = 0;
-  }
-  bool ok() const { return ok_; }
-
- private:
-  std::string name_;
-  pid_t pid_ = 0;
-  bool ok_ = false;
-};
 
 struct Sink {
   void OnSafe(const lcm::ReceiveBuffer*, const std::string&, const force_command_t* msg) {
@@ -78,11 +51,11 @@ TEST(ControllerKill, SafetyFallsBackWithinTheStaleAgeAndThePlantKeepsGettingComm
     head.insert(head.end(), common.begin(), common.end());
     return head;
   };
-  Child safety("safety", with({SAFETY_PATH}));
-  Child controller("controller", with({CONTROLLER_PATH, "--scenario", "paper"}));
-  Child estimator("estimator", with({ESTIMATOR_PATH}));
-  Child plant("plant_sim", with({PLANT_SIM_PATH, "--mode", "realtime"}));
-  ASSERT_TRUE(safety.ok() && controller.ok() && estimator.ok() && plant.ok());
+  test::ChildProcess safety(with({SAFETY_PATH}));
+  test::ChildProcess controller(with({CONTROLLER_PATH, "--scenario", "paper"}));
+  test::ChildProcess estimator(with({ESTIMATOR_PATH}));
+  test::ChildProcess plant(with({PLANT_SIM_PATH, "--mode", "realtime"}));
+  ASSERT_TRUE(safety.started() && controller.started() && estimator.started() && plant.started());
 
   auto pump_for = [&](double seconds) {
     const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);

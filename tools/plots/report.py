@@ -95,10 +95,10 @@ def replay_section(run):
     max_diff = float(diff.max()) if len(diff) else float("nan")
     worst = common[int(np.argmax(diff))] if len(diff) else None
     cf_s, qp_s = cf["safety"], qp["safety"]
-    lines += [f"`stewart_replay` re-ran the filter offline on the {len(common)} recorded nominal "
-              f"commands with their state estimates (same sample_utime), once as the closed "
-              f"form and once as the QP reference ({qp_s['qp_solver']}); the live filter was "
-              f"{cf_s['recorded_variant']}.", ""]
+    lines += [f"`stewart_replay` re-ran the safety process offline on the recorded state "
+              f"estimates and nominal commands (in log order), once with the closed form and "
+              f"once with the QP reference ({qp_s['qp_solver']}): {len(common)} safe commands; "
+              f"the live filter was {cf_s['recorded_variant']}.", ""]
     lines += [f"- max |F_closed_form - F_qp| over every step: **{max_diff:.3g} N**"
               + (f" (at sample_utime {worst} us)" if worst is not None and max_diff > 0 else "")]
     verdict = "met" if max_diff < 1e-6 else "NOT met"

@@ -1,4 +1,4 @@
-// stewart_replay: re-runs the safety filter (and optionally the controller
+// stewart_replay: re-runs the safety process (and optionally the controller
 // and the estimator) offline on the inputs recorded in a run folder of
 // tools/launch.sh, and compares with what the live processes published.
 //
@@ -228,31 +228,37 @@ int main(int argc, char** argv) {
 
   stewart::replay::Options o;
   CLI::App app{
-      "Re-run the safety filter (and the controller, the estimator) offline on the inputs "
+      "Re-run the safety process (and the controller, the estimator) offline on the inputs "
       "recorded by tools/launch.sh and compare with the recorded outputs"};
   app.add_option("run", o.run, "run folder of tools/launch.sh (or its log.lcm)")->required();
-  app.add_option("--log", o.log_path, "LCM log (default: <run>/log.lcm)");
-  app.add_option("--config", o.config_path, "stack config (default: <run>/config.yaml)");
-  app.add_option("--scenario", o.scenario_path,
-                 "scenario for --controller (default: <run>/scenario.yaml)");
-  app.add_option(
+  CLI::Option_group* inputs = app.add_option_group("Inputs", "what the run recorded");
+  inputs->add_option("--log", o.log_path, "LCM log (default: <run>/log.lcm)");
+  inputs->add_option("--config", o.config_path, "stack config (default: <run>/config.yaml)");
+  inputs->add_option("--scenario", o.scenario_path,
+                     "scenario for --controller (default: <run>/scenario.yaml)");
+  inputs->add_option("--channel-suffix", o.channel_suffix,
+                     "channel suffix the run used (default: lcm.channel_suffix of the config)");
+  CLI::Option_group* filter = app.add_option_group("Safety filter", "the filter to replay");
+  filter->add_option(
       "--variant", o.variant,
       stewart::kSafetyVariantNames.Names() + " (default: the run's, run.yaml, else the config's)");
-  app.add_option("--qp-solver", o.qp_solver, "reference QP solver for variant qp: clp | alglib");
-  app.add_option("--k-velocity", o.k_velocity, "override safety.k_velocity");
-  app.add_option("--k-position", o.k_position, "override safety.k_position");
-  app.add_flag("--force-limits", o.force_limits,
-               "also enforce |F_i| <= actuators.force_limit_n (as safety --force-limits)");
-  app.add_option("--channel-suffix", o.channel_suffix,
-                 "channel suffix the run used (default: lcm.channel_suffix of the config)");
-  app.add_flag("--controller", o.controller,
-               "also replay the controller on the recorded estimates");
-  app.add_flag("--estimator", o.estimator,
-               "also replay the estimator on the recorded sensors and safe commands");
-  app.add_option("--json", o.json_path, "write the numbers as JSON to FILE");
-  app.add_option("--csv", o.csv_path, "write every replayed filter step to FILE");
-  app.add_flag("--expect-identical", o.expect_identical,
-               "exit 1 unless every replayed output is bit-identical to the recorded one");
+  filter->add_option("--qp-solver", o.qp_solver,
+                     "reference QP solver for variant qp: clp | alglib");
+  filter->add_option("--k-velocity", o.k_velocity, "override safety.k_velocity");
+  filter->add_option("--k-position", o.k_position, "override safety.k_position");
+  filter->add_flag("--force-limits", o.force_limits,
+                   "also enforce |F_i| <= actuators.force_limit_n (as safety --force-limits)");
+  CLI::Option_group* also = app.add_option_group("Other processes", "replayed besides safety");
+  also->add_flag("--controller", o.controller,
+                 "also replay the controller on the recorded estimates");
+  also->add_flag("--estimator", o.estimator,
+                 "also replay the estimator on the recorded sensors and safe commands");
+  CLI::Option_group* outputs = app.add_option_group("Outputs");
+  outputs->add_option("--json", o.json_path, "write the numbers as JSON to FILE");
+  outputs->add_option("--csv", o.csv_path,
+                      "write every safe command the replayed safety process published to FILE");
+  outputs->add_flag("--expect-identical", o.expect_identical,
+                    "exit 1 unless every replayed output is bit-identical to the recorded one");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -1,8 +1,11 @@
 #include "stewart/test_support/recorded_run.h"
 
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <lcm/lcm-cpp.hpp>
 #include <optional>
 
@@ -91,6 +94,25 @@ RecordedRun ReadRecordedRun(const std::string& log_path, const StackConfig& conf
     }
   }
   return s;
+}
+
+std::string Describe(const RecordedRun& run) {
+  const Bound* worst = run.Worst();
+  char text[256];
+  std::snprintf(
+      text, sizeof text,
+      "%ld truth samples over %.2f s, max x %.5f m, max xd %.5f m/s, max excess %.2e (%s)",
+      run.truth_samples, run.truth_span_s, run.max_x, run.max_xd, worst->max_excess,
+      worst->name.c_str());
+  return text;
+}
+
+void ExpectWithinLimits(const RecordedRun& run) {
+  for (const Bound& b : run.bounds) {
+    EXPECT_LE(b.max_excess, kLimitTolerance)
+        << b.name << " exceeded by " << b.max_excess << " at t = " << b.at_s << " s (value "
+        << b.value_at_max << ")";
+  }
 }
 
 }  // namespace stewart::test

@@ -40,6 +40,8 @@ class ConfigNode {
   double NonNegativeDouble(std::string_view key) const;
   std::optional<double> OptionalDouble(std::string_view key) const;
   int Int(std::string_view key) const;
+  /// An integer within [lo, hi]; outside, the error says `reason`.
+  int IntInRange(std::string_view key, int lo, int hi, const std::string& reason) const;
   bool Bool(std::string_view key) const;
   std::string String(std::string_view key) const;
   /// A string that must be one of `allowed`.

@@ -25,49 +25,50 @@ class Transport {
   virtual std::string description() const = 0;
 };
 
+/// A transport on a file descriptor it owns (closed with it).
+class FdTransport : public Transport {
+ public:
+  ~FdTransport() override;
+  FdTransport(const FdTransport&) = delete;
+  FdTransport& operator=(const FdTransport&) = delete;
+
+  int fd() const override { return fd_; }
+  std::string description() const override { return description_; }
+
+ protected:
+  FdTransport(int fd, std::string description);
+
+  int fd_;
+  std::string description_;
+};
+
 /// UDP bound to bind_host:bind_port, sending to peer_host:peer_port. Only
 /// datagrams from the peer's address are accepted; others are counted in
 /// foreign_datagrams(). Throws std::runtime_error naming the address.
-class UdpTransport final : public Transport {
+class UdpTransport final : public FdTransport {
  public:
   UdpTransport(const std::string& bind_host, int bind_port, const std::string& peer_host,
                int peer_port);
-  ~UdpTransport() override;
-  UdpTransport(const UdpTransport&) = delete;
-  UdpTransport& operator=(const UdpTransport&) = delete;
 
   bool Send(const uint8_t* data, std::size_t size) override;
   long Receive(uint8_t* buffer, std::size_t capacity, int timeout_ms) override;
   bool datagram() const override { return true; }
-  int fd() const override { return fd_; }
-  std::string description() const override { return description_; }
   uint64_t foreign_datagrams() const { return foreign_; }
 
  private:
-  int fd_ = -1;
   uint32_t peer_addr_ = 0;  // network order
   uint16_t peer_port_ = 0;  // network order
   uint64_t foreign_ = 0;
-  std::string description_;
 };
 
 /// A byte stream on a file descriptor it owns (a tty or a pty master).
-class FdStreamTransport : public Transport {
+class FdStreamTransport : public FdTransport {
  public:
   FdStreamTransport(int fd, std::string description);
-  ~FdStreamTransport() override;
-  FdStreamTransport(const FdStreamTransport&) = delete;
-  FdStreamTransport& operator=(const FdStreamTransport&) = delete;
 
   bool Send(const uint8_t* data, std::size_t size) override;
   long Receive(uint8_t* buffer, std::size_t capacity, int timeout_ms) override;
   bool datagram() const override { return false; }
-  int fd() const override { return fd_; }
-  std::string description() const override { return description_; }
-
- private:
-  int fd_;
-  std::string description_;
 };
 
 /// Opens a serial device raw (8N1, no flow control, no echo) at `baud`.

@@ -1,6 +1,8 @@
 #pragma once
 // Conversions between the LCM messages and the libraries' signals
 // (common/signals.h), at the edge of every node and of replay.
+#include <tuple>
+
 #include "stewart/common/signals.h"
 #include "stewart/force_command_t.hpp"
 #include "stewart/node/eigen_msg.h"
@@ -23,46 +25,41 @@ static_assert(kCommandFilterActive == force_command_t::FLAG_FILTER_ACTIVE &&
                   kCommandForceLimited == force_command_t::FLAG_FORCE_LIMITED,
               "signals.h and force_command_t.FLAG_* must agree");
 
-inline StateSample FromMessage(const state_t& msg) {
-  StateSample s;
-  s.utime = msg.utime;
-  s.seq = msg.seq;
-  s.sample_utime = msg.sample_utime;
-  s.q = FromArray(msg.q);
-  s.qd = FromArray(msg.qd);
-  s.q_std = FromArray(msg.q_std);
-  s.qd_std = FromArray(msg.qd_std);
-  s.status = msg.status;
-  return s;
+/// For each message, the library signal it carries and the fields both share
+/// (by the same names), in one list for both directions.
+template <typename Msg>
+struct SignalOf;
+
+template <>
+struct SignalOf<state_t> {
+  using Type = StateSample;
+  template <typename State>
+  static auto Fields(State& s) {
+    return std::tie(s.utime, s.seq, s.sample_utime, s.q, s.qd, s.q_std, s.qd_std, s.status);
+  }
+};
+
+template <>
+struct SignalOf<force_command_t> {
+  using Type = ForceCommand;
+  template <typename Command>
+  static auto Fields(Command& c) {
+    return std::tie(c.utime, c.seq, c.sample_utime, c.force_n, c.flags);
+  }
+};
+
+/// state_t -> StateSample, force_command_t -> ForceCommand.
+template <typename Msg>
+typename SignalOf<Msg>::Type FromMessage(const Msg& msg) {
+  typename SignalOf<Msg>::Type signal;
+  CopyFields(SignalOf<Msg>::Fields(msg), SignalOf<Msg>::Fields(signal));
+  return signal;
 }
 
-inline void ToMessage(const StateSample& s, state_t* msg) {
-  msg->utime = s.utime;
-  msg->seq = s.seq;
-  msg->sample_utime = s.sample_utime;
-  ToArray(s.q, msg->q);
-  ToArray(s.qd, msg->qd);
-  ToArray(s.q_std, msg->q_std);
-  ToArray(s.qd_std, msg->qd_std);
-  msg->status = s.status;
-}
-
-inline ForceCommand FromMessage(const force_command_t& msg) {
-  ForceCommand c;
-  c.utime = msg.utime;
-  c.seq = msg.seq;
-  c.sample_utime = msg.sample_utime;
-  c.force_n = FromArray(msg.force_n);
-  c.flags = msg.flags;
-  return c;
-}
-
-inline void ToMessage(const ForceCommand& c, force_command_t* msg) {
-  msg->utime = c.utime;
-  msg->seq = c.seq;
-  msg->sample_utime = c.sample_utime;
-  ToArray(c.force_n, msg->force_n);
-  msg->flags = c.flags;
+/// StateSample -> state_t, ForceCommand -> force_command_t.
+template <typename Msg>
+void ToMessage(const typename SignalOf<Msg>::Type& signal, Msg* msg) {
+  CopyFields(SignalOf<Msg>::Fields(signal), SignalOf<Msg>::Fields(*msg));
 }
 
 }  // namespace stewart

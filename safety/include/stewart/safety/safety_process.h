@@ -44,17 +44,16 @@ class SafetyProcess {
   /// publish: the filtered command, or a fallback for a stale one.
   bool OnNominal(const ForceCommand& nominal, SafetyOutput* out);
 
+  const SafetyFilter& filter() const { return filter_; }
+  int64_t stale_age_us() const { return stale_age_us_; }
+
+ private:
   /// The filter step for a nominal command against its state (what OnState
   /// and OnNominal publish when they filter).
   SafetyOutput Filter(const StateSample& state, const ForceCommand& nominal);
   /// The safe stop at `state`, flagged with `reason` (kCommandStaleInput or
   /// kCommandInvalidInput).
   SafetyOutput Fallback(const StateSample& state, int32_t reason);
-
-  const SafetyFilter& filter() const { return filter_; }
-  int64_t stale_age_us() const { return stale_age_us_; }
-
- private:
   const StateSample* FindState(int64_t sample_utime) const;
   /// Publishing bookkeeping shared by every output.
   SafetyOutput Emit(const Vector6d& force_n, int64_t sample_utime, int32_t fallback_reason);

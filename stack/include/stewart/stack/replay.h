@@ -1,13 +1,15 @@
 #pragma once
-// Offline replay of a run recorded by tools/launch.sh: the safety filter, the
-// controller and the estimator re-run on the recorded inputs (read with
+// Offline replay of a run recorded by tools/launch.sh: the safety, controller
+// and estimator processes re-run on the recorded inputs (read with
 // lcm::LogFile, no network) and their outputs compared with what the live
 // processes published. docs/operations.md, "Replay".
 //
-// Each replay mirrors its node: messages are matched by sample_utime as the
-// node matches them, the node's status checks and fallbacks are applied the
-// same way, and the library is the one the node links, so on the same build
-// the replayed outputs are bit-identical to the recorded ones.
+// Each replay drives the process's own class (SafetyProcess,
+// ControllerProcess, EstimatorProcess: the decisions the node makes) with the
+// recorded messages of its input channels in the order the log received them,
+// and pairs what it publishes with the recorded outputs by sample_utime. So
+// on the same build the replayed outputs are bit-identical to the recorded
+// ones by construction.
 #include <array>
 #include <cstdint>
 #include <map>
@@ -41,6 +43,9 @@ struct RecordedDiagnostics {
   int64_t compute_ns = 0;
   int8_t variant = 0;  ///< safety_diagnostics_t::VARIANT_*
   bool force_limits = false;
+  int8_t active_case = 0;       ///< safety_diagnostics_t::CASE_*
+  int32_t fallback_reason = 0;  ///< force_command_t::FLAG_* that caused a fallback
+  int32_t flags = 0;            ///< the filter step's force_command_t::FLAG_*
 };
 
 enum class Channel {
@@ -103,6 +108,15 @@ struct DiffStats {
            bool other_fields_equal);
 };
 
+/// How the outputs of one replayed process pair with the recorded ones, by
+/// sample_utime.
+struct OutputPairing {
+  long replayed = 0;                 ///< outputs the replay published
+  long recorded = 0;                 ///< outputs in the log
+  long without_recorded = 0;         ///< replayed, none recorded with that sample_utime
+  long recorded_without_replay = 0;  ///< recorded, not published by the replay
+};
+
 /// Per-step times (ns): numpy's default (linear) percentiles.
 struct TimeStats {
   long count = 0;
@@ -115,19 +129,22 @@ TimeStats ComputeTimeStats(std::vector<int64_t> ns);
 // ---------------------------------------------------------------------------
 // Safety filter
 
-/// How the recorded safe command for one replayed nominal command was made.
+/// How one safe command the replayed process published compares with the
+/// recorded one of the same sample_utime.
 enum class SafetyStepKind {
-  kCompared,    ///< by the filter: compared with the replay
-  kFallback,    ///< the live node answered with a fallback (FLAG_FALLBACK / FLAG_STALE_INPUT)
+  kCompared,    ///< the recorded one is the filter's answer: compared with the replay
+  kFallback,    ///< the recorded one is a fallback (FLAG_FALLBACK / FLAG_STALE_INPUT)
   kUnrecorded,  ///< no recorded safe command with this sample_utime
+  kLogGap,      ///< the replay's watchdog while the log lacked nominal commands: not compared
 };
-inline constexpr EnumTable<SafetyStepKind, 3> kSafetyStepKindNames{{{
+inline constexpr EnumTable<SafetyStepKind, 4> kSafetyStepKindNames{{{
     {SafetyStepKind::kCompared, "compared"},
     {SafetyStepKind::kFallback, "fallback"},
     {SafetyStepKind::kUnrecorded, "unrecorded"},
+    {SafetyStepKind::kLogGap, "log_gap"},
 }}};
 
-/// One replayed filter step (one recorded nominal command with its state).
+/// One safe command the replayed process published.
 struct SafetyStep {
   int64_t sample_utime = 0;
   SafetyStepKind kind = SafetyStepKind::kCompared;
@@ -151,30 +168,42 @@ struct SafetyReplayResult {
   std::optional<SafetyVariant> recorded_variant;
   std::optional<bool> recorded_force_limits;
 
-  long nominal_commands = 0;          ///< recorded nominal commands
-  long without_state = 0;             ///< no recorded estimate with their sample_utime
-  long without_recorded_command = 0;  ///< no recorded safe command with their sample_utime
-  long answered_by_fallback = 0;      ///< the recorded safe command is a fallback
-  DiffStats filter;                   ///< the filter's commands: replay vs recorded
-  long flags_differ = 0;              ///< among them, force_command_t.flags differ
+  long states = 0;                ///< recorded estimates (SafetyProcess::OnState)
+  long nominal_commands = 0;      ///< recorded nominal commands (SafetyProcess::OnNominal)
+  long without_state = 0;         ///< nominal commands without a recorded estimate of their sample
+  long answered_by_fallback = 0;  ///< nominal commands whose recorded safe command is a fallback
+  OutputPairing commands;         ///< the safe commands the replay published vs the recorded
+  /// kCompared: the filter's commands, replay vs recorded; identical also needs
+  /// equal flags and, where recorded, equal diagnostics (case, fallback reason, flags).
+  DiffStats filter;
+  long flags_differ = 0;  ///< among them, force_command_t.flags differ
+  /// Compared commands (either kind) whose recorded diagnostics differ from
+  /// the replayed ones in case, fallback reason or flags.
+  long diagnostics_differ = 0;
 
-  /// Every recorded fallback command (FLAG_FALLBACK or FLAG_STALE_INPUT),
-  /// whether or not a nominal command exists for it, by the path the node took.
+  /// Every recorded fallback command (FLAG_FALLBACK or FLAG_STALE_INPUT), by
+  /// the path the replayed process took for it (kFallback steps).
   long fallback_commands = 0;
-  long fallback_stale_input = 0;    ///< node watchdog / stale nominal (FLAG_STALE_INPUT)
-  long fallback_invalid_state = 0;  ///< node: state not valid (estimator initialising, diverged)
+  long fallback_stale_input = 0;    ///< watchdog or stale nominal (FLAG_STALE_INPUT)
+  long fallback_invalid_state = 0;  ///< state not usable (estimator initialising, diverged)
   long fallback_by_filter = 0;      ///< the filter's own last resort (infeasible, invalid F_des)
-  long fallback_without_input = 0;  ///< no recorded state (or nominal) to replay it from
-  DiffStats fallback;               ///< replayed safe stop / filter vs recorded
+  long fallback_without_input = 0;  ///< not replayed: its inputs are not in the log
+  DiffStats fallback;               ///< kFallback: replay vs recorded
+  /// kLogGap: watchdog fallbacks of the replay while the log lacked nominal
+  /// commands (a seq gap) the live process had received.
+  long log_gap = 0;
 
   TimeStats replayed_ns;  ///< filter time of the replay, over the compared steps
   TimeStats recorded_ns;  ///< the live filter's (safety_diagnostics_t.compute_ns), same steps
   safety::FilterCaseCounts replayed_cases{};  ///< per FilterCase, over every replayed step
-  std::vector<SafetyStep> steps;              ///< in recorded nominal order
+  std::vector<SafetyStep> steps;              ///< in the order the replay published them
 };
 
-/// `config.safety` is the filter to replay (variant, k, ...); `reference` is
-/// needed for variant qp and must outlive the call.
+/// SafetyProcess::OnState / OnNominal on every recorded estimate and nominal
+/// command in log order; every safe command it publishes is compared with the
+/// recorded one of the same sample_utime. `config.safety` is the filter to
+/// replay (variant, k, ...); `reference` is needed for variant qp and must
+/// outlive the call.
 SafetyReplayResult ReplaySafety(const StackConfig& config, const RecordedLog& log,
                                 safety::ReferenceQpSolver* reference);
 
@@ -192,11 +221,8 @@ struct ControllerReplayResult {
   long states = 0;          ///< recorded state estimates
   long invalid_states = 0;  ///< not STATUS_VALID or STATUS_DIVERGED: skipped as the node does
   long step_rejected = 0;   ///< Controller::Step returned an error: nothing published
-  long replayed = 0;        ///< nominal commands the replay produced
-  long recorded_commands = 0;
-  long without_recorded_command = 0;  ///< replayed, none recorded with that sample_utime
-  long recorded_without_replay = 0;   ///< recorded, not produced by the replay
-  DiffStats nominal;                  ///< force_n; identical also needs equal flags
+  OutputPairing commands;   ///< the nominal commands the replay published vs the recorded
+  DiffStats nominal;        ///< force_n; identical also needs equal flags
   long flags_differ = 0;
 };
 
@@ -206,33 +232,34 @@ ControllerReplayResult ReplayController(const StackConfig& config, const Scenari
 // ---------------------------------------------------------------------------
 // Estimator
 
-struct EstimatorReplayResult {
-  bool perfect_state = false;  ///< estimator.perfect_state: truth republished
-  long sensor_samples = 0;
-  long commands = 0;           ///< safe commands fed to the EKF
-  long rejected_commands = 0;  ///< non-finite: ignored as the node does
-  long replayed = 0;           ///< estimates the replay published
-  long recorded_estimates = 0;
-  long without_recorded_estimate = 0;
-  long recorded_without_replay = 0;
-  /// Sensor samples and safe commands missing from the log (seq gaps): the
-  /// estimates after the first such gap cannot be reproduced.
-  long inputs_missing = 0;
-  int64_t inputs_intact_until_utime = -1;  ///< valid when inputs_missing > 0
-  /// Over q, qd, q_std, qd_std, up to the first input gap; identical also
-  /// needs equal utime and status.
-  DiffStats state;
+/// Replayed against recorded estimates.
+struct EstimateDiff {
+  /// Over q, qd, q_std, qd_std; identical also needs equal utime and status.
+  DiffStats values;
   double max_abs_diff_q = 0.0;   ///< m or rad
   double max_abs_diff_qd = 0.0;  ///< m/s or rad/s
   /// Largest difference in q_i or qd_i in sigmas of the difference of the two
   /// estimates, hypot(recorded std, replayed std).
   double max_diff_sigma = 0.0;
+
+  void Add(const state_t& replayed, const state_t& recorded);
+};
+
+struct EstimatorReplayResult {
+  bool perfect_state = false;  ///< estimator.perfect_state: truth republished
+  long sensor_samples = 0;
+  long commands = 0;           ///< safe commands fed to the EKF
+  long rejected_commands = 0;  ///< non-finite: ignored as the node does
+  OutputPairing estimates;     ///< the estimates the replay published vs the recorded
+  /// Sensor samples and safe commands missing from the log (seq gaps): the
+  /// estimates after the first such gap cannot be reproduced.
+  long inputs_missing = 0;
+  int64_t inputs_intact_until_utime = -1;  ///< valid when inputs_missing > 0
+  /// Up to the first input gap.
+  EstimateDiff state;
   long status_differ = 0;
   /// After the first input gap: reported only, not counted as differing.
-  DiffStats after_gap;
-  double max_abs_diff_q_after_gap = 0.0;
-  double max_abs_diff_qd_after_gap = 0.0;
-  double max_diff_sigma_after_gap = 0.0;
+  EstimateDiff after_gap;
 };
 
 EstimatorReplayResult ReplayEstimator(const StackConfig& config, const RecordedLog& log);

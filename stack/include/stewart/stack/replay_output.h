@@ -29,8 +29,9 @@ struct ReplayReport {
 
 nlohmann::ordered_json ToJson(const ReplayReport& report);
 std::string FormatSummary(const ReplayReport& report);
-/// One row per replayed filter step: sample_utime, kind, flags, case, times,
-/// replayed and recorded forces (17 significant digits: exact doubles).
+/// One row per safe command the replayed process published: sample_utime,
+/// kind, flags, case, times, replayed and recorded forces (17 significant
+/// digits: exact doubles).
 void WriteSafetyStepsCsv(const SafetyReplayResult& safety, std::ostream& out);
 
 }  // namespace stewart::replay

@@ -1,14 +1,17 @@
 #pragma once
 // SafetyDiagnostics -> stewart::safety_diagnostics_t, for the safety node
-// only (the core library has no LCM). Header-only: target stewart_safety_lcm.
+// and replay (the core library has no LCM). Header-only: target stewart_safety_lcm.
 // Reusing one message object across steps keeps the string and array
 // capacities, so steady-state filling does not allocate.
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <string>
 #include <utility>
+#include <vector>
 
 #include "stewart/safety/safety_filter.h"
+#include "stewart/safety/safety_process.h"
 #include "stewart/safety_diagnostics_t.hpp"
 
 namespace stewart::safety {
@@ -38,6 +41,47 @@ inline SafetyVariant FromLcmVariant(std::int8_t value) {
   return SafetyVariant::kClosedForm;
 }
 
+/// The per-barrier fields of one barrier group of safety_diagnostics_t
+/// (position or velocity).
+struct DiagnosticsGroupFields {
+  std::int32_t* num;
+  std::vector<std::string>* names;
+  std::vector<double>* h;
+  std::vector<double>* alpha_h;
+  std::vector<double>* w;
+  std::vector<double>* mu;
+};
+
+inline DiagnosticsGroupFields PositionGroup(safety_diagnostics_t* msg) {
+  return {&msg->num_position,     &msg->position_names, &msg->h_position,
+          &msg->alpha_h_position, &msg->w_position,     &msg->mu_position};
+}
+
+inline DiagnosticsGroupFields VelocityGroup(safety_diagnostics_t* msg) {
+  return {&msg->num_velocity,     &msg->velocity_names, &msg->h_velocity,
+          &msg->alpha_h_velocity, &msg->w_velocity,     &msg->mu_velocity};
+}
+
+/// The first `n` barriers of a group: their names and their values of one
+/// step. Resizing keeps the vectors' capacities.
+template <typename Specs, typename Values>
+void FillGroup(int n, const Specs& specs, const Values& h, const Values& alpha_h, const Values& w,
+               const Values& mu, const DiagnosticsGroupFields& group) {
+  const size_t count = static_cast<size_t>(n);
+  *group.num = n;
+  for (std::vector<double>* values : {group.h, group.alpha_h, group.w, group.mu}) {
+    values->resize(count);
+  }
+  group.names->resize(count);
+  for (size_t i = 0; i < count; ++i) {
+    (*group.names)[i] = specs[i].name;
+    (*group.h)[i] = h[i];
+    (*group.alpha_h)[i] = alpha_h[i];
+    (*group.w)[i] = w[i];
+    (*group.mu)[i] = mu[i];
+  }
+}
+
 /// Fills everything but utime, seq and sample_utime (the node's job).
 inline void FillDiagnosticsMessage(const SafetyFilter& filter, const SafetyDiagnostics& d,
                                    safety_diagnostics_t* msg) {
@@ -50,32 +94,10 @@ inline void FillDiagnosticsMessage(const SafetyFilter& filter, const SafetyDiagn
   msg->active_case = static_cast<std::int8_t>(d.filter_case);
   msg->infeasible = d.infeasible;
   msg->fallback_reason = d.flags & (kFlagInfeasible | kFlagFallback | kFlagInvalidInput);
-  msg->num_position = c.num_position;
-  msg->position_names.resize(static_cast<size_t>(c.num_position));
-  msg->h_position.resize(static_cast<size_t>(c.num_position));
-  msg->alpha_h_position.resize(static_cast<size_t>(c.num_position));
-  msg->w_position.resize(static_cast<size_t>(c.num_position));
-  msg->mu_position.resize(static_cast<size_t>(c.num_position));
-  for (size_t i = 0; i < static_cast<size_t>(c.num_position); ++i) {
-    msg->position_names[i] = c.position[i].name;
-    msg->h_position[i] = b.h_position[i];
-    msg->alpha_h_position[i] = b.alpha_h_position[i];
-    msg->w_position[i] = b.w_position[i];
-    msg->mu_position[i] = d.mu_position[i];
-  }
-  msg->num_velocity = c.num_velocity;
-  msg->velocity_names.resize(static_cast<size_t>(c.num_velocity));
-  msg->h_velocity.resize(static_cast<size_t>(c.num_velocity));
-  msg->alpha_h_velocity.resize(static_cast<size_t>(c.num_velocity));
-  msg->w_velocity.resize(static_cast<size_t>(c.num_velocity));
-  msg->mu_velocity.resize(static_cast<size_t>(c.num_velocity));
-  for (size_t i = 0; i < static_cast<size_t>(c.num_velocity); ++i) {
-    msg->velocity_names[i] = c.velocity[i].name;
-    msg->h_velocity[i] = b.h_velocity[i];
-    msg->alpha_h_velocity[i] = b.alpha_h_velocity[i];
-    msg->w_velocity[i] = b.w_velocity[i];
-    msg->mu_velocity[i] = d.mu_velocity[i];
-  }
+  FillGroup(c.num_position, c.position, b.h_position, b.alpha_h_position, b.w_position,
+            d.mu_position, PositionGroup(msg));
+  FillGroup(c.num_velocity, c.velocity, b.h_velocity, b.alpha_h_velocity, b.w_velocity,
+            d.mu_velocity, VelocityGroup(msg));
   msg->h_pos = b.h_pos;
   msg->h_vel = b.h_vel;
   msg->psi_p = b.psi_p;
@@ -93,6 +115,17 @@ inline void FillDiagnosticsMessage(const SafetyFilter& filter, const SafetyDiagn
   msg->compute_ns = d.compute_ns;
   msg->flags = d.flags;
   msg->force_limits = filter.force_limits();
+}
+
+/// The diagnostics message of one output of SafetyProcess, as the node
+/// publishes it beside the safe command.
+inline void FillDiagnosticsMessage(const SafetyFilter& filter, const SafetyOutput& out,
+                                   safety_diagnostics_t* msg) {
+  FillDiagnosticsMessage(filter, *out.diagnostics, msg);
+  msg->utime = out.command.utime;
+  msg->seq = out.command.seq;
+  msg->sample_utime = out.command.sample_utime;
+  msg->fallback_reason |= out.fallback_reason;
 }
 
 }  // namespace stewart::safety

@@ -1,14 +1,17 @@
 #pragma once
-// Building LCM messages and logs in tests: a message appended to an LCM log
-// file as the logger would record it, and the variable-length barrier groups
-// of a safety_diagnostics_t filled in one call.
+// LCM messages and logs in tests: a message appended to an LCM log file as
+// the logger would record it, the variable-length barrier groups of a
+// safety_diagnostics_t filled in one call, and the messages a test receives.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cstdint>
 #include <lcm/lcm-cpp.hpp>
 #include <string>
+#include <utility>
 #include <vector>
 
+#include "stewart/safety/diagnostics_lcm.h"
 #include "stewart/safety_diagnostics_t.hpp"
 
 namespace stewart::test {
@@ -36,18 +39,39 @@ struct DiagnosticsGroup {
 /// Sets both groups and their counts.
 inline void SetGroups(const DiagnosticsGroup& position, const DiagnosticsGroup& velocity,
                       safety_diagnostics_t* d) {
-  d->num_position = static_cast<int32_t>(position.names.size());
-  d->position_names = position.names;
-  d->h_position = position.h;
-  d->alpha_h_position = position.alpha_h;
-  d->w_position = position.w;
-  d->mu_position = position.mu;
-  d->num_velocity = static_cast<int32_t>(velocity.names.size());
-  d->velocity_names = velocity.names;
-  d->h_velocity = velocity.h;
-  d->alpha_h_velocity = velocity.alpha_h;
-  d->w_velocity = velocity.w;
-  d->mu_velocity = velocity.mu;
+  for (const auto& [group, fields] : {std::pair{&position, safety::PositionGroup(d)},
+                                      std::pair{&velocity, safety::VelocityGroup(d)}}) {
+    *fields.num = static_cast<int32_t>(group->names.size());
+    *fields.names = group->names;
+    *fields.h = group->h;
+    *fields.alpha_h = group->alpha_h;
+    *fields.w = group->w;
+    *fields.mu = group->mu;
+  }
+}
+
+/// Every message of one type a subscription received, in order:
+/// `lcm->subscribe(channel, &Inbox<Msg>::On, &inbox)`.
+template <typename Msg>
+struct Inbox {
+  void On(const lcm::ReceiveBuffer*, const std::string&, const Msg* msg) {
+    received.push_back(*msg);
+  }
+  std::vector<Msg> received;
+};
+
+/// Handles `lcm`'s messages until `done()` or `timeout_s` has passed:
+/// whether `done()`.
+template <typename Done>
+bool HandleUntil(lcm::LCM* lcm, Done done, double timeout_s, int step_ms = 20) {
+  const auto deadline = std::chrono::steady_clock::now() +
+                        std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                            std::chrono::duration<double>(timeout_s));
+  while (!done()) {
+    if (std::chrono::steady_clock::now() > deadline) return false;
+    lcm->handleTimeout(step_ms);
+  }
+  return true;
 }
 
 }  // namespace stewart::test

@@ -53,4 +53,12 @@ struct RecordedRun {
 /// `config.safety`. An unreadable log reads as an empty run.
 RecordedRun ReadRecordedRun(const std::string& log_path, const StackConfig& config);
 
+/// "N truth samples over S s, max x, max xd, max excess (the worst bound)",
+/// for a test's log line; `run` must have bounds.
+std::string Describe(const RecordedRun& run);
+
+/// Expects every bound of `run` kept within kLimitTolerance on the ground
+/// truth; each failure names the bound, its excess and when.
+void ExpectWithinLimits(const RecordedRun& run);
+
 }  // namespace stewart::test
