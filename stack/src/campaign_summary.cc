@@ -67,6 +67,40 @@ bool IsVelocityLimit(const std::string& name) {
   return underscore != std::string::npos && underscore >= 1 && name[underscore - 1] == 'd';
 }
 
+// Ranks (0 .. n-1, ties averaged) of `v`.
+std::vector<double> Ranks(const std::vector<double>& v) {
+  std::vector<std::size_t> order(v.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return v[a] < v[b]; });
+  std::vector<double> rank(v.size());
+  for (std::size_t i = 0; i < order.size();) {
+    std::size_t j = i;
+    while (j + 1 < order.size() && v[order[j + 1]] == v[order[i]]) ++j;
+    for (std::size_t k = i; k <= j; ++k) rank[order[k]] = 0.5 * static_cast<double>(i + j);
+    i = j + 1;
+  }
+  return rank;
+}
+
+// Spearman's rank correlation; NaN when either side is constant.
+double RankCorrelation(const std::vector<double>& x, const std::vector<double>& y) {
+  const std::vector<double> rx = Ranks(x), ry = Ranks(y);
+  const double n = static_cast<double>(x.size());
+  double mx = 0.0, my = 0.0;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    mx += rx[i] / n;
+    my += ry[i] / n;
+  }
+  double sxy = 0.0, sxx = 0.0, syy = 0.0;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    sxy += (rx[i] - mx) * (ry[i] - my);
+    sxx += (rx[i] - mx) * (rx[i] - mx);
+    syy += (ry[i] - my) * (ry[i] - my);
+  }
+  return sxx > 0.0 && syy > 0.0 ? sxy / std::sqrt(sxx * syy)
+                                : std::numeric_limits<double>::quiet_NaN();
+}
+
 std::string Fmt(const char* format, double v) {
   char buffer[64];
   std::snprintf(buffer, sizeof buffer, format, v);
@@ -177,6 +211,26 @@ json SummarizeCampaign(const CsvTable& runs, const json& meta, double tolerance)
   s["limits"] = limits;
   s["worst_position_margin_m"] = Quantiles(worst_position);
   s["worst_velocity_margin_mps"] = Quantiles(worst_velocity);
+  // Which sampled parameter moves the worst margins: the columns between
+  // `scenario` and the first limit, by rank correlation over the runs.
+  json parameters = json::array();
+  const int first_sampled = runs.Column("scenario") + 1;
+  for (std::size_t c = static_cast<std::size_t>(std::max(first_sampled, 0));
+       first_sampled > 0 && c < runs.header.size() && !EndsWith(runs.header[c], "_excess"); ++c) {
+    std::vector<double> x, position, velocity;
+    for (std::size_t r = 0; r < n; ++r) {
+      const double v = runs.Number(r, static_cast<int>(c));
+      if (!std::isfinite(v)) continue;
+      x.push_back(v);
+      position.push_back(worst_position[r]);
+      velocity.push_back(worst_velocity[r]);
+    }
+    if (x.size() < 3) continue;
+    parameters.push_back({{"parameter", runs.header[c]},
+                          {"rank_correlation_position", RankCorrelation(x, position)},
+                          {"rank_correlation_velocity", RankCorrelation(x, velocity)}});
+  }
+  s["parameters"] = parameters;
 
   auto column_values = [&](const char* name) {
     std::vector<double> v;
@@ -281,6 +335,30 @@ std::string SummaryMarkdown(const json& s) {
   quantile_row("tracking rms, setpoints inside the limits", s["tracking_rms_m"], 1e3, "mm");
   quantile_row("estimate rms, translation", s["estimate_rms_m"], 1e3, "mm");
   quantile_row("wall time per run", s["wall_s_per_run"], 1.0, "s");
+  if (s.contains("parameters") && !s["parameters"].empty()) {
+    // Strongest first: the parameters that move the worst margins most.
+    std::vector<json> rows(s["parameters"].begin(), s["parameters"].end());
+    auto strength = [](const json& p) {
+      double best = 0.0;
+      for (const char* k : {"rank_correlation_position", "rank_correlation_velocity"}) {
+        if (p[k].is_number()) best = std::max(best, std::fabs(p[k].get<double>()));
+      }
+      return best;
+    };
+    std::stable_sort(rows.begin(), rows.end(),
+                     [&](const json& a, const json& b) { return strength(a) > strength(b); });
+    o << "\n## Which parameter moves the worst margin\n\nSpearman rank correlation over the "
+         "runs (+: a larger value leaves more margin; margin_vs_parameters.png shows them).\n\n"
+         "| parameter | position margin | velocity margin |\n| --- | --- | --- |\n";
+    constexpr std::size_t kShown = 10;
+    for (std::size_t i = 0; i < rows.size() && i < kShown; ++i) {
+      o << "| " << rows[i]["parameter"].get<std::string>() << " |";
+      for (const char* k : {"rank_correlation_position", "rank_correlation_velocity"}) {
+        o << " " << (rows[i][k].is_number() ? Fmt("%+.2f", rows[i][k].get<double>()) : "-") << " |";
+      }
+      o << "\n";
+    }
+  }
   o << "\n## Health\n\n";
   o << "- estimator restarts: " << s["estimator_restarts"].get<double>() << " in "
     << s["runs_with_estimator_restarts"].get<long>() << " runs; rejected samples "
@@ -288,7 +366,8 @@ std::string SummaryMarkdown(const json& s) {
   o << "- runs with fallback ticks: " << s["runs_with_fallback"].get<long>()
     << "; with infeasible ticks: " << s["runs_with_infeasible"].get<long>()
     << "; with end-stop hits: " << s["runs_with_endstop_hits"].get<long>() << " ("
-    << s["endstop_hits"].get<double>() << " hits); plant intervals integrated by the stiff "
+    << s["endstop_hits"].get<double>()
+    << " hits); plant intervals integrated by the stiff "
        "fallback in "
     << s.value("runs_with_stiff_fallbacks", 0L) << " runs\n";
   o << "- failed runs: " << s["failed_runs"].size() << "\n";

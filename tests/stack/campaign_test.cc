@@ -177,3 +177,34 @@ TEST(Campaign, EndStopChatterFallsBackToTheStiffIntegratorAndTheRunCompletes) {
 
 }  // namespace
 }  // namespace stewart
+
+namespace stewart {
+namespace {
+
+// The summary ranks the sampled parameters by how they move the worst
+// margins: a parameter the margin follows exactly correlates +1, one it
+// follows backwards -1.
+TEST(CampaignSummary, RanksTheParametersThatMoveTheMargin) {
+  CsvTable t;
+  t.header = {"index",           "seed",           "scenario",           "p_follows",
+              "p_against",       "x_upper_excess", "x_upper_margin",     "xd_upper_excess",
+              "xd_upper_margin", "completed",      "estimator_restarts", "wall_s"};
+  const double follows[] = {0.1, 0.5, 0.2, 0.9, 0.4};
+  for (int r = 0; r < 5; ++r) {
+    const double margin = 0.01 * follows[r] - 0.002;
+    t.rows.push_back({std::to_string(r), "1", "paper", std::to_string(follows[r]),
+                      std::to_string(-follows[r]), std::to_string(std::max(0.0, -margin)),
+                      std::to_string(margin), "0", std::to_string(0.001 + 0.0001 * r), "1", "0",
+                      "0.1"});
+  }
+  const nlohmann::json s = SummarizeCampaign(t, {}, 1e-3);
+  ASSERT_EQ(s["parameters"].size(), 2u);
+  EXPECT_EQ(s["parameters"][0]["parameter"], "p_follows");
+  EXPECT_NEAR(s["parameters"][0]["rank_correlation_position"].get<double>(), 1.0, 1e-12);
+  EXPECT_NEAR(s["parameters"][1]["rank_correlation_position"].get<double>(), -1.0, 1e-12);
+  EXPECT_NE(SummaryMarkdown(s).find("| p_follows | +1.00 |"), std::string::npos)
+      << SummaryMarkdown(s);
+}
+
+}  // namespace
+}  // namespace stewart

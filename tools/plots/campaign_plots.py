@@ -45,6 +45,9 @@ def main(folder):
         values = sorted(v for v in worst_by_group[group] if not math.isnan(v))
         n = len(values)
         ax.step(values, [(i + 1) / n for i in range(n)], where="post")
+        # Margins run from metres outside to millimetres inside: linear near
+        # zero (the tolerance), logarithmic beyond.
+        ax.set_xscale("symlog", linthresh=1.0)
         ax.axvline(0.0, color="k", lw=0.8)
         ax.axvline(-1.0, color="r", lw=0.8, ls="--", label="tolerance (-1)")
         ax.set_xlabel(f"worst {group} margin over the run ({unit}); < 0: limit exceeded")
@@ -65,6 +68,7 @@ def main(folder):
             for group, _, unit in groups:
                 ax.scatter(x, worst_by_group[group], s=4, label=f"{group} ({unit})")
             ax.axhline(0.0, color="k", lw=0.8)
+            ax.set_yscale("symlog", linthresh=1.0)
             ax.set_xlabel(p, fontsize=8)
             ax.tick_params(labelsize=7)
             ax.grid(alpha=0.3)
