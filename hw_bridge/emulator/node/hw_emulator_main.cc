@@ -1,6 +1,8 @@
 // hw_emulator: the device side of the wire protocol on plant_sim's plant
 // model (EmulatorNode). It runs without LCM: only --lcm-url turns on the
 // ground truth.
+#include <spdlog/spdlog.h>
+
 #include "emulator_node.h"
 #include "stewart/config/truth_loader.h"
 #include "stewart/node/node_main.h"
@@ -55,6 +57,8 @@ int main(int argc, char** argv) {
       },
       [&](const stewart::StackConfig& config, lcm::LCM* lcm) {
         stewart::EmulatorNode node(config, truth, lcm, options);
+        spdlog::info("hw_emulator: physics from {}",
+                     truth_path.empty() ? "the config" : "truth " + truth_path);
         return node.Run();
       });
 }
