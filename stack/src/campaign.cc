@@ -114,6 +114,7 @@ CampaignRow RunCampaignRow(const CampaignSpec& spec, long index, std::ostream* t
   options.duration_s = run.duration_s;
   options.seed = run.seed;
   options.truth = run.truth;
+  options.perfect_state = spec.perfect_state;
   CampaignRow row;
   row.index = index;
   row.seed = run.seed;
@@ -175,10 +176,10 @@ std::vector<std::string> CampaignColumns(const CampaignSpec& spec) {
   const std::vector<std::string> limits = LimitNames(spec.config.safety);
   for (const std::string& name : limits) columns.push_back(name + "_excess");
   for (const std::string& name : limits) columns.push_back(name + "_margin");
-  for (const char* name : {"tracking_rms_m", "estimate_rms_m", "estimate_rms_mps",
-                           "estimator_restarts", "estimator_rejections", "fallback_ticks",
-                           "infeasible_ticks", "endstop_hits", "stiff_fallbacks", "completed", "failure",
-                           "wall_s"}) {
+  for (const char* name :
+       {"tracking_rms_m", "estimate_rms_m", "estimate_rms_mps", "estimator_restarts",
+        "estimator_rejections", "fallback_ticks", "infeasible_ticks", "endstop_hits",
+        "stiff_fallbacks", "completed", "failure", "wall_s"}) {
     columns.push_back(name);
   }
   return columns;
@@ -194,7 +195,8 @@ std::string CampaignCsvLine(const CampaignSpec& spec, const CampaignRow& row) {
   line << ',' << Number(s.rms_translation_tracking_inside_m) << ',' << Number(s.rms_q_error) << ','
        << Number(s.rms_qd_error) << ',' << s.estimator_reinits << ',' << s.estimator_rejections
        << ',' << s.fallback_ticks << ',' << s.infeasible_ticks << ',' << s.endstop_hits << ','
-       << s.stiff_fallbacks << ',' << (s.completed ? 1 : 0) << ',' << CsvField(s.failure) << ',' << Number(row.wall_s);
+       << s.stiff_fallbacks << ',' << (s.completed ? 1 : 0) << ',' << CsvField(s.failure) << ','
+       << Number(row.wall_s);
   return line.str();
 }
 

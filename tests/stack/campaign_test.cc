@@ -208,3 +208,23 @@ TEST(CampaignSummary, RanksTheParametersThatMoveTheMargin) {
 
 }  // namespace
 }  // namespace stewart
+
+namespace stewart {
+namespace {
+
+// --perfect-state: the controller and the filter get ground truth, so no
+// estimator settles (no fallback at the start) and nothing is estimated.
+TEST(Campaign, PerfectStateBypassesTheEstimator) {
+  CampaignSpec spec = Spec("paper", kBounds);
+  const CampaignRow with_ekf = RunCampaignRow(spec, 2, nullptr);
+  spec.perfect_state = true;
+  const CampaignRow perfect = RunCampaignRow(spec, 2, nullptr);
+  EXPECT_GT(with_ekf.summary.fallback_ticks, 0);
+  EXPECT_GT(with_ekf.summary.rms_q_error, 0.0);
+  EXPECT_EQ(perfect.summary.fallback_ticks, 0);
+  EXPECT_EQ(perfect.summary.rms_q_error, 0.0);
+  EXPECT_EQ(perfect.summary.estimator_reinits, 0);
+}
+
+}  // namespace
+}  // namespace stewart

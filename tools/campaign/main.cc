@@ -121,8 +121,11 @@ CampaignSpec LoadSavedSpec(const std::string& dir) {
   const json meta = json::parse(ReadText(dir + "/campaign.json"));
   const std::string mismatch =
       meta.contains("mismatch_copy") ? dir + "/" + meta["mismatch_copy"].get<std::string>() : "";
-  return MakeCampaignSpec(dir + "/config.yaml", meta["scenario"].get<std::string>(), mismatch,
-                          meta["seed"].get<std::uint64_t>(), meta["duration_s"].get<double>());
+  CampaignSpec spec =
+      MakeCampaignSpec(dir + "/config.yaml", meta["scenario"].get<std::string>(), mismatch,
+                       meta["seed"].get<std::uint64_t>(), meta["duration_s"].get<double>());
+  spec.perfect_state = meta.value("perfect_state", false);
+  return spec;
 }
 
 int Run(const CampaignSpec& spec, long runs, int shard, int shards, int jobs,
@@ -266,7 +269,7 @@ int main(int argc, char** argv) {
   std::uint64_t seed = 1;
   int jobs = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   double duration_s = 0.0;
-  bool no_plots = false, emit_truth = false;
+  bool no_plots = false, emit_truth = false, perfect_state = false;
   std::string log_level = "error";
   std::vector<std::string> merge_dirs;
   app.add_option("--config", config_path, "stack YAML config (the model every run's stack uses)")
@@ -291,6 +294,8 @@ int main(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   app.add_option("--out", out, "output folder")->capture_default_str();
   app.add_flag("--no-plots", no_plots, "skip the matplotlib plots");
+  app.add_flag("--perfect-state", perfect_state,
+               "ground truth to the controller and filter instead of the EKF");
   app.add_option("--log-level", log_level,
                  "what the runs' estimator, controller and filter log (their rejections are "
                  "counted in runs.csv either way)")
@@ -315,7 +320,8 @@ int main(int argc, char** argv) {
     if (!(shard_in >> shard >> slash >> shards) || slash != '/' || !shard_in.eof()) {
       throw InputError("--shard", "expected K/N, got '" + shard_text + "'");
     }
-    const CampaignSpec spec = MakeCampaignSpec(config_path, scenario, mismatch, seed, duration_s);
+    CampaignSpec spec = MakeCampaignSpec(config_path, scenario, mismatch, seed, duration_s);
+    spec.perfect_state = perfect_state;
     return Run(spec, runs, shard, shards, jobs, out, !no_plots);
   } catch (const InputError& e) {
     spdlog::error("stewart_campaign: {}", e.what());

@@ -34,6 +34,9 @@ struct CampaignSpec {
   double duration_s = 0.0;  ///< 0: the scenario's
   /// Random scenarios last this long (s).
   double random_duration_s = 40.0;
+  /// Ground truth to the controller and filter instead of the EKF (to tell
+  /// the estimator's share of a failure from the rest's).
+  bool perfect_state = false;
 };
 
 /// Loads the config, the distribution (if any) and checks the scenario.
