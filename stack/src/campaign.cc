@@ -71,7 +71,9 @@ RunSetup SetUpRun(const CampaignSpec& spec, long index) {
   run.truth_yaml = sampled.truth;
   run.sampled = std::move(sampled.values);
   if (spec.scenario == "random") {
-    const RandomRun random = MakeRandomRun(spec.config, spec.random_duration_s, &rng);
+    // The random setpoints span the run, however long it is.
+    const double length_s = spec.duration_s > 0.0 ? spec.duration_s : spec.random_duration_s;
+    const RandomRun random = MakeRandomRun(spec.config, length_s, &rng);
     run.scenario = random.scenario;
     run.scenario_yaml = random.scenario_yaml;
     YAML::Node pose(YAML::NodeType::Sequence), velocity(YAML::NodeType::Sequence);

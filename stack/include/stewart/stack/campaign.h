@@ -32,7 +32,7 @@ struct CampaignSpec {
   CampaignDistribution distribution;
   std::uint64_t seed = 1;
   double duration_s = 0.0;  ///< 0: the scenario's
-  /// Random scenarios last this long (s).
+  /// Random scenarios last this long (s) when duration_s is 0.
   double random_duration_s = 40.0;
   /// Ground truth to the controller and filter instead of the EKF (to tell
   /// the estimator's share of a failure from the rest's).
