@@ -3,6 +3,7 @@
 // safety_tool (JSON lines in, F* and diagnostics out). Both must carry
 // exactly what the library computed, so anyone can recheck a step.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <array>
 #include <cmath>
@@ -142,7 +143,11 @@ TEST(DiagnosticsMessage, ComputeNsIsTheTimeOfTheFullStep) {
 }
 
 std::string RunTool(const std::string& input, const std::string& args) {
-  const std::string in_path = ::testing::TempDir() + "safety_tool_in.jsonl";
+  // One file per test and process: ctest runs the tests of this file in
+  // parallel, and a shared name let one test read the other's input.
+  const std::string in_path = ::testing::TempDir() + "safety_tool_in_" +
+                              ::testing::UnitTest::GetInstance()->current_test_info()->name() +
+                              "_" + std::to_string(::getpid()) + ".jsonl";
   std::ofstream(in_path) << input;
   const std::string command =
       std::string(SAFETY_TOOL_PATH) + " " + args + " < " + in_path + " 2>/dev/null";
@@ -152,6 +157,8 @@ std::string RunTool(const std::string& input, const std::string& args) {
   while (pipe && std::fgets(buffer.data(), buffer.size(), pipe.get()) != nullptr) {
     out += buffer.data();
   }
+  pipe.reset();
+  std::remove(in_path.c_str());
   return out;
 }
 

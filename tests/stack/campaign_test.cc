@@ -4,6 +4,7 @@
 #include "stewart/stack/campaign.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cstdio>
 #include <filesystem>
@@ -83,7 +84,8 @@ TEST(Campaign, SampledValuesReachTheTruth) {
 TEST(Campaign, ExactModelHoldsAndSummaryAgreesWithTheRows) {
   const CampaignSpec spec = Spec("paper", "");
   const std::vector<std::string> lines = RunCampaignLines(spec, ShardIndices(2, 1, 1), 2, nullptr);
-  const std::string dir = testing::TempDir() + "/campaign_summary_test";
+  const std::string dir =
+      testing::TempDir() + "/campaign_summary_test_" + std::to_string(::getpid());
   std::filesystem::create_directories(dir);
   {
     std::ofstream csv(dir + "/runs.csv");
@@ -119,7 +121,9 @@ struct BadDistribution {
 class CampaignRejects : public ::testing::TestWithParam<BadDistribution> {};
 
 TEST_P(CampaignRejects, NamingTheKey) {
-  const std::string path = testing::TempDir() + "/bad_distribution.yaml";
+  // One file per parameter: ctest runs the instances in parallel.
+  const std::string path =
+      testing::TempDir() + "/bad_distribution_" + std::to_string(::getpid()) + ".yaml";
   {
     std::ofstream out(path);
     out << GetParam().yaml;
