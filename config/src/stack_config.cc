@@ -93,19 +93,19 @@ StackConfig ParseStackConfig(const std::string& yaml_text) {
   return ParseRoot(yaml, "");
 }
 
-StackConfig LoadStackConfig(const std::string& path) {
+YAML::Node LoadYamlFile(const std::string& path) {
   std::ifstream file(path);
   if (!file) throw ConfigError("<file>", "cannot open '" + path + "'");
   std::stringstream text;
   text << file.rdbuf();
-  YAML::Node yaml;
   try {
-    yaml = YAML::Load(text.str());
+    return YAML::Load(text.str());
   } catch (const YAML::Exception& e) {
     throw ConfigError("<yaml>", "'" + path + "' is not valid YAML: " + e.what());
   }
-  return ParseRoot(yaml, path);
 }
+
+StackConfig LoadStackConfig(const std::string& path) { return ParseRoot(LoadYamlFile(path), path); }
 
 std::string DefaultConfigPath() {
   if (const char* env = std::getenv("STEWART_CONFIG"); env != nullptr && *env != '\0') {

@@ -3,9 +3,7 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <set>
-#include <sstream>
 
 #include "stewart/config/sections.h"
 #include "stewart/model/kinematics.h"
@@ -14,7 +12,7 @@ namespace stewart {
 namespace {
 
 constexpr double kDegToRad = 3.141592653589793 / 180.0;
-constexpr double kMaxLatencyS = 0.4;  // Plant's delay queue holds 0.5 s at 1 kHz
+constexpr double kMaxLatencyS = 0.4;  // the message below; Plant's delay queue holds 0.5 s at 1 kHz
 
 // Keys a truth may set, per section: the config's own and the truth's extras.
 const std::set<std::string> kPlatformKeys = {"base_joint_radius_m",
@@ -163,25 +161,7 @@ Disturbance ParseDisturbance(const ConfigNode& root, const YAML::Node& truth) {
   return d;
 }
 
-std::string Fmt(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
-
 }  // namespace
-
-YAML::Node LoadYamlFile(const std::string& path) {
-  std::ifstream file(path);
-  if (!file) throw ConfigError("<file>", "cannot open '" + path + "'");
-  std::stringstream text;
-  text << file.rdbuf();
-  try {
-    return YAML::Load(text.str());
-  } catch (const YAML::Exception& e) {
-    throw ConfigError("<yaml>", "'" + path + "' is not valid YAML: " + e.what());
-  }
-}
 
 PlantTruth ParsePlantTruth(const StackConfig& config, const YAML::Node& config_root,
                            const YAML::Node& truth) {
@@ -266,8 +246,7 @@ PlantTruth ParsePlantTruth(const StackConfig& config, const YAML::Node& config_r
       (std::string(key) == "sensor_ms" ? t.latency.sensor_s : t.latency.command_s) = s_value;
     }
     if (t.latency.total_s() > kMaxLatencyS) {
-      latency.Fail("command_ms",
-                   "sensor_ms + command_ms must not exceed " + Fmt(kMaxLatencyS * 1e3) + " ms");
+      latency.Fail("command_ms", "sensor_ms + command_ms must not exceed 400 ms");
     }
   }
 

@@ -1,7 +1,10 @@
 #include "stewart/plant_sim/disturbance_source.h"
 
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
+
+#include "stewart/common/check.h"
 
 namespace stewart {
 namespace {
@@ -21,6 +24,8 @@ DisturbanceSource::DisturbanceSource(const Disturbance& disturbance, unsigned ru
              !(disturbance.random_pushes.rate_hz > 0.0 &&
                disturbance.random_pushes.max_force_n > 0.0)),
       rng_((static_cast<std::uint64_t>(disturbance.random_pushes.seed) << 32) ^ run_seed) {
+  // Overlapping pushes at once: rate x duration on average; room for far more.
+  pushes_.reserve(64);
   if (disturbance_.random_pushes.rate_hz > 0.0) {
     next_push_s_ = std::exponential_distribution<double>(disturbance_.random_pushes.rate_hz)(rng_);
   }
@@ -47,6 +52,8 @@ void DisturbanceSource::DrawPushesUntil(double t_s) {
 
 Vector6d DisturbanceSource::WrenchAt(double t_s) {
   if (empty_) return Vector6d::Zero();
+  STEWART_CHECK(t_s >= last_query_s_, "DisturbanceSource::WrenchAt: time went backwards");
+  last_query_s_ = t_s;
   Vector6d w = disturbance_.constant;
   for (const WrenchStep& s : disturbance_.steps)
     if (t_s >= s.start_s) w += s.wrench;
@@ -55,6 +62,13 @@ Vector6d DisturbanceSource::WrenchAt(double t_s) {
   for (const WrenchSinusoid& s : disturbance_.sinusoids)
     w += s.amplitude * std::sin(kTwoPi * s.frequency_hz * t_s + s.phase_rad);
   DrawPushesUntil(t_s);
+  // Every push lasts duration_s and they start in order: the ended ones are
+  // a prefix.
+  std::size_t ended = 0;
+  while (ended < pushes_.size() && t_s >= pushes_[ended].start_s + pushes_[ended].duration_s) {
+    ++ended;
+  }
+  pushes_.erase(pushes_.begin(), pushes_.begin() + static_cast<std::ptrdiff_t>(ended));
   for (const WrenchPulse& p : pushes_)
     if (Active(t_s, p.start_s, p.duration_s)) w += p.wrench;
   return w;

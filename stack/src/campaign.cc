@@ -45,11 +45,10 @@ CampaignSpec MakeCampaignSpec(const std::string& config_path, const std::string&
   spec.config = LoadStackConfig(config_path);
   spec.config_root = LoadYamlFile(config_path);
   spec.scenario = scenario;
-  if (scenario != "random") LoadScenario(ResolveScenarioPath(scenario));  // fails early
+  if (scenario != "random") spec.fixed_scenario = LoadScenario(ResolveScenarioPath(scenario));
   spec.distribution_path = distribution_path;
   if (!distribution_path.empty()) {
-    spec.distribution_yaml = LoadYamlFile(distribution_path);
-    spec.distribution = ParseDistribution(spec.distribution_yaml, spec.config_root);
+    spec.distribution = ParseDistribution(LoadYamlFile(distribution_path), spec.config_root);
   }
   spec.seed = seed;
   if (!(duration_s >= 0.0)) throw InputError("--duration", "must not be negative");
@@ -86,7 +85,7 @@ RunSetup SetUpRun(const CampaignSpec& spec, long index) {
     run.truth_yaml["initial_state"]["pose"] = pose;
     run.truth_yaml["initial_state"]["velocity"] = velocity;
   } else {
-    run.scenario = LoadScenario(ResolveScenarioPath(spec.scenario));
+    run.scenario = *spec.fixed_scenario;
   }
   run.truth = ParsePlantTruth(spec.config, spec.config_root, run.truth_yaml);
   run.duration_s = spec.duration_s > 0.0 ? spec.duration_s : run.scenario.duration_s();
@@ -139,7 +138,6 @@ std::vector<long> ShardIndices(long runs, int shard, int shards) {
 CampaignSpec CloneSpec(const CampaignSpec& spec) {
   CampaignSpec copy = spec;
   copy.config_root = YAML::Clone(spec.config_root);
-  copy.distribution_yaml = YAML::Clone(spec.distribution_yaml);
   for (ParameterSpec& p : copy.distribution.parameters) p.fixed = YAML::Clone(p.fixed);
   return copy;
 }
@@ -185,6 +183,14 @@ std::vector<std::string> CampaignColumns(const CampaignSpec& spec) {
     columns.push_back(name);
   }
   return columns;
+}
+
+std::string CampaignCsvHeader(const CampaignSpec& spec) {
+  std::string header;
+  for (const std::string& column : CampaignColumns(spec)) {
+    header += (header.empty() ? "" : ",") + column;
+  }
+  return header;
 }
 
 std::string CampaignCsvLine(const CampaignSpec& spec, const CampaignRow& row) {

@@ -132,24 +132,31 @@ double CsvTable::Number(std::size_t row, int column) const {
   return std::stod(s);
 }
 
-CsvTable ReadCsv(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path, "cannot open");
+CsvTable ParseCsv(const std::string& text, const std::string& source) {
+  std::istringstream in(text);
   CsvTable table;
   std::string line;
-  if (!std::getline(in, line)) throw InputError(path, "empty file, expected a CSV header");
+  if (!std::getline(in, line)) throw InputError(source, "empty, expected a CSV header");
   table.header = SplitCsvLine(line);
   for (long n = 2; std::getline(in, line); ++n) {
     if (line.empty()) continue;
     std::vector<std::string> fields = SplitCsvLine(line);
     if (fields.size() != table.header.size()) {
-      throw InputError(path + ":" + std::to_string(n), "has " + std::to_string(fields.size()) +
-                                                           " fields, the header " +
-                                                           std::to_string(table.header.size()));
+      throw InputError(source + ":" + std::to_string(n), "has " + std::to_string(fields.size()) +
+                                                             " fields, the header " +
+                                                             std::to_string(table.header.size()));
     }
     table.rows.push_back(std::move(fields));
   }
   return table;
+}
+
+CsvTable ReadCsv(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path, "cannot open");
+  std::stringstream text;
+  text << in.rdbuf();
+  return ParseCsv(text.str(), path);
 }
 
 void WriteCsv(const std::string& path, const CsvTable& table) {

@@ -89,9 +89,7 @@ TEST(Campaign, ExactModelHoldsAndSummaryAgreesWithTheRows) {
   std::filesystem::create_directories(dir);
   {
     std::ofstream csv(dir + "/runs.csv");
-    const std::vector<std::string> columns = CampaignColumns(spec);
-    for (std::size_t i = 0; i < columns.size(); ++i) csv << (i ? "," : "") << columns[i];
-    csv << '\n';
+    csv << CampaignCsvHeader(spec) << '\n';
     for (const std::string& l : lines) csv << l << '\n';
   }
   const CsvTable table = ReadCsv(dir + "/runs.csv");

@@ -145,9 +145,7 @@ int Run(const CampaignSpec& spec, long runs, int shard, int shards, int jobs,
   const double wall =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   std::ofstream csv(out + "/runs.csv");
-  const std::vector<std::string> columns = CampaignColumns(spec);
-  for (std::size_t i = 0; i < columns.size(); ++i) csv << (i ? "," : "") << columns[i];
-  csv << '\n';
+  csv << CampaignCsvHeader(spec) << '\n';
   for (const std::string& line : lines) csv << line << '\n';
   csv.close();
   std::fprintf(stderr, "campaign: %zu runs in %.1f s wall\n", lines.size(), wall);
@@ -213,17 +211,11 @@ int Rerun(const std::string& dir, long row_number, bool emit_truth) {
   const CampaignRow row = RunCampaignRow(spec, index, &trajectory);
   const std::string line = CampaignCsvLine(spec, row);
   // Every field but the wall time must be what the campaign wrote.
-  std::vector<std::string> fresh;
-  {
-    std::ofstream tmp(stem + ".row.csv");
-    const std::vector<std::string> columns = CampaignColumns(spec);
-    for (std::size_t i = 0; i < columns.size(); ++i) tmp << (i ? "," : "") << columns[i];
-    tmp << '\n' << line << '\n';
-  }
-  const CsvTable again = ReadCsv(stem + ".row.csv");
-  fs::remove(stem + ".row.csv");
+  const CsvTable again = ParseCsv(CampaignCsvHeader(spec) + "\n" + line + "\n",
+                                  "rerun of row " + std::to_string(row_number));
   const int wall_col = runs.Column("wall_s");
   bool same = again.header == runs.header;
+  if (!same) spdlog::error("rerun: runs.csv has other columns (written by another version?)");
   for (std::size_t c = 0; same && c < stored.size(); ++c) {
     if (static_cast<int>(c) != wall_col && again.rows[0][c] != stored[c]) {
       spdlog::error("rerun: column {} is {} now, {} in runs.csv", runs.header[c], again.rows[0][c],

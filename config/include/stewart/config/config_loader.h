@@ -9,6 +9,10 @@ namespace stewart {
 
 /// Loads and validates; throws ConfigError naming the key and the reason.
 StackConfig LoadStackConfig(const std::string& path);
+
+/// A YAML file, unparsed into structs; ConfigError("<file>" or "<yaml>")
+/// naming the file when it cannot be read or is not YAML.
+YAML::Node LoadYamlFile(const std::string& path);
 StackConfig ParseStackConfig(const std::string& yaml_text);
 
 /// Cross-section checks (home pose inside the stroke and inside every limit,

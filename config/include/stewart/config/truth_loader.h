@@ -8,6 +8,7 @@
 
 #include <string>
 
+#include "stewart/config/config_loader.h"
 #include "stewart/config/config_node.h"
 #include "stewart/config/stack_config.h"
 #include "stewart/plant_sim/truth.h"
@@ -24,8 +25,5 @@ PlantTruth LoadPlantTruth(const StackConfig& config, const std::string& truth_pa
 /// a truth document (a mapping; an empty one gives the config's values).
 PlantTruth ParsePlantTruth(const StackConfig& config, const YAML::Node& config_root,
                            const YAML::Node& truth);
-
-/// Reads a YAML file; ConfigError("<file>"/"<yaml>") when it cannot.
-YAML::Node LoadYamlFile(const std::string& path);
 
 }  // namespace stewart

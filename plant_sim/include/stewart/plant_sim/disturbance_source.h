@@ -15,9 +15,10 @@ class DisturbanceSource {
   /// draws its own pushes from one file.
   DisturbanceSource(const Disturbance& disturbance, unsigned run_seed);
 
-  /// The wrench at t_s (s from the plant's start). The random pushes are drawn
-  /// in time order from their seed, so the value at t does not depend on
-  /// which times were asked before.
+  /// The wrench at t_s (s from the plant's start). Times must not decrease
+  /// from call to call (a plant's clock); the random pushes are drawn in time
+  /// order from their seed, so the sequence of values does not depend on how
+  /// often it is asked. No allocation once running (ended pushes are dropped).
   Vector6d WrenchAt(double t_s);
 
   bool empty() const { return empty_; }
@@ -29,7 +30,8 @@ class DisturbanceSource {
   bool empty_;
   std::mt19937_64 rng_;
   double next_push_s_ = 0.0;
-  std::vector<WrenchPulse> pushes_;
+  double last_query_s_ = 0.0;
+  std::vector<WrenchPulse> pushes_;  // drawn and not yet ended, in start order
 };
 
 }  // namespace stewart

@@ -8,6 +8,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -19,16 +20,15 @@
 
 namespace stewart {
 
-/// The scenarios a campaign knows by name; anything else is a scenario file.
-inline constexpr const char* kCampaignScenarios[] = {"paper", "beyond-limits", "circle", "random"};
-
 struct CampaignSpec {
   std::string config_path;
   StackConfig config;
   YAML::Node config_root;
-  std::string scenario = "paper";  ///< a name above, or a scenario file
-  std::string distribution_path;   ///< empty: the exact model (truth = config)
-  YAML::Node distribution_yaml;
+  /// "random" (drawn per run), a name of config/scenarios or a scenario file.
+  std::string scenario = "paper";
+  /// The scenario every run follows, loaded once; absent for "random".
+  std::optional<Scenario> fixed_scenario;
+  std::string distribution_path;  ///< empty: the exact model (truth = config)
   CampaignDistribution distribution;
   std::uint64_t seed = 1;
   double duration_s = 0.0;  ///< 0: the scenario's
@@ -76,6 +76,7 @@ CampaignRow RunCampaignRow(const CampaignSpec& spec, long index, std::ostream* t
 /// runs.csv: header and one line per row. Numbers are written with 17
 /// significant digits so a row read back is the row computed.
 std::vector<std::string> CampaignColumns(const CampaignSpec& spec);
+std::string CampaignCsvHeader(const CampaignSpec& spec);  ///< the columns, comma-separated
 std::string CampaignCsvLine(const CampaignSpec& spec, const CampaignRow& row);
 
 /// The run indices of shard `shard` (1-based) of `shards`: every index i in

@@ -24,6 +24,8 @@ std::string CsvField(const std::string& s);
 /// Reads a CSV written by the campaign (RFC 4180 quoting). Throws InputError
 /// naming the file and line when a row has the wrong number of fields.
 CsvTable ReadCsv(const std::string& path);
+/// The same from text; `source` names it in errors.
+CsvTable ParseCsv(const std::string& text, const std::string& source);
 void WriteCsv(const std::string& path, const CsvTable& table);
 
 /// `meta` (campaign settings) is copied into the summary's "campaign" entry.
