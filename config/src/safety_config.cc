@@ -73,6 +73,15 @@ SafetyConfig ParseSafetyConfig(const ConfigNode& safety) {
     s.position_robust_margin_w = safety.NonNegativeDouble("position_robust_margin_w");
   }
   if (safety.Has("model_leg_friction")) s.model_leg_friction = safety.Bool("model_leg_friction");
+  if (safety.Has("recovery_gain_per_s")) {
+    s.recovery_gain_per_s = safety.NonNegativeDouble("recovery_gain_per_s");
+  }
+  if (safety.Has("use_disturbance_estimate")) {
+    s.use_disturbance_estimate = safety.Bool("use_disturbance_estimate");
+  }
+  if (safety.Has("disturbance_sigma")) {
+    s.disturbance_sigma = safety.NonNegativeDouble("disturbance_sigma");
+  }
   return s;
 }
 

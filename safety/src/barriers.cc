@@ -10,12 +10,13 @@ namespace stewart::safety {
 void EvaluateBarriers(const ConstraintSet& c, const Vector6d& q, const Vector6d& qd,
                       const DynamicsTerms& terms, const Vector6d& f_des, BarrierEvaluation* out) {
   BarrierIntermediates unused;
-  EvaluateBarriers(c, q, qd, terms, f_des, 0.0, out, &unused);
+  EvaluateBarriers(c, q, qd, terms, f_des, 0.0, GeneralizedDisturbance{}, out, &unused);
 }
 
 void EvaluateBarriers(const ConstraintSet& c, const Vector6d& q, const Vector6d& qd,
                       const DynamicsTerms& terms, const Vector6d& f_des, double leg_friction_nspm,
-                      BarrierEvaluation* out, BarrierIntermediates* x) {
+                      const GeneralizedDisturbance& disturbance, BarrierEvaluation* out,
+                      BarrierIntermediates* x) {
   // The per-barrier arrays hold kMax* entries (a hand-built ConstraintSet
   // skips BuildConstraintSet's capacity check).
   STEWART_CHECK(static_cast<unsigned>(c.num_position) <= kMaxPositionBarriers &&
@@ -25,8 +26,14 @@ void EvaluateBarriers(const ConstraintSet& c, const Vector6d& q, const Vector6d&
   x->leg_rate.noalias() = terms.H.transpose() * qd;  // ld = J_l qd, J_l = H^T
   // The conditions hold for what the legs really push: F + friction.
   const Vector6d f_net = f_des + LegViscousFriction(leg_friction_nspm, x->leg_rate);
-  Vector6d generalised_force;  // H F_net
+  Vector6d generalised_force;  // H F_net + d^
   generalised_force.noalias() = terms.H * f_net;
+  generalised_force += disturbance.force_n;
+  // k_sigma sigma_j: how far each entry of d may be from d^.
+  const Vector6d d_bound = c.disturbance_sigma * disturbance.std_n;
+  const bool robust = (d_bound.array() > 0.0).any();
+  e.outside_position_set = false;
+  e.outside_safe_set = false;
   x->m_qd.noalias() = terms.M * qd;
   x->qd_m_qd = qd.dot(x->m_qd);
   // One factor of M per step, shared by the velocity group and the
@@ -35,8 +42,10 @@ void EvaluateBarriers(const ConstraintSet& c, const Vector6d& q, const Vector6d&
 
   if (c.num_position > 0) {
     const double kinetic = 0.5 * x->qd_m_qd;
-    // -qd^T (H F_des - G): the power term common to every position barrier.
-    const double power = -qd.dot(generalised_force - terms.G);
+    // -qd^T (H F_des + d^ - G): the power term common to every position
+    // barrier, at its worst over the disturbance's uncertainty.
+    const double power =
+        -qd.dot(generalised_force - terms.G) - (robust ? qd.cwiseAbs().dot(d_bound) : 0.0);
     for (int i = 0; i < c.num_position; ++i) {
       const size_t k = static_cast<size_t>(i);
       const PositionBarrierSpec& s = c.position[k];
@@ -44,6 +53,10 @@ void EvaluateBarriers(const ConstraintSet& c, const Vector6d& q, const Vector6d&
       const double value = axis ? q(s.index) : terms.leg_length_m(s.index);
       const double rate = axis ? qd(s.index) : x->leg_rate(s.index);
       const double h = s.sign * (value - s.limit);
+      if (h < 0.0) {
+        e.outside_safe_set = true;
+        e.outside_position_set = e.outside_position_set || (axis && c.has_recovery);
+      }
       e.h_position[k] = -kinetic + s.alpha_e * h;
       e.alpha_h_position[k] = s.alpha * e.h_position[k];
       e.dh_position[k] = power + s.alpha_e * s.sign * rate;
@@ -69,6 +82,7 @@ void EvaluateBarriers(const ConstraintSet& c, const Vector6d& q, const Vector6d&
 
   x->a_c.setZero();
   if (c.num_velocity > 0) {
+    std::array<double, kMaxVelocityBarriers> recovery_slope;  // dphi/dh (1/s)
     if (!x->inertia_valid) {
       // M^-1 does not exist: no velocity condition can be evaluated.
       e.h_vel = e.psi_v = NAN;
@@ -79,7 +93,16 @@ void EvaluateBarriers(const ConstraintSet& c, const Vector6d& q, const Vector6d&
     for (int i = 0; i < c.num_velocity; ++i) {
       const size_t k = static_cast<size_t>(i);
       const VelocityBarrierSpec& s = c.velocity[k];
-      e.h_velocity[k] = s.sign * (qd(s.axis) - s.limit);
+      if (s.recovery_of < 0) {
+        e.h_velocity[k] = s.sign * (qd(s.axis) - s.limit);
+        if (e.h_velocity[k] < 0.0) e.outside_safe_set = true;
+      } else {
+        const PositionBarrierSpec& p = c.position[static_cast<size_t>(s.recovery_of)];
+        double phi = 0.0, dphi_dh = 0.0;
+        RecoveryTarget(s, p.sign * (q(p.index) - p.limit), &phi, &dphi_dh);
+        e.h_velocity[k] = s.sign * qd(s.axis) + phi;
+        recovery_slope[k] = dphi_dh;
+      }
       e.alpha_h_velocity[k] = s.alpha_v * e.h_velocity[k];
     }
     e.h_vel = ComposeLogSumExp(e.alpha_h_velocity.data(), c.num_velocity, c.k_velocity,
@@ -89,16 +112,22 @@ void EvaluateBarriers(const ConstraintSet& c, const Vector6d& q, const Vector6d&
       const VelocityBarrierSpec& s = c.velocity[k];
       x->a_c(s.axis) += s.alpha_v * e.w_velocity[k] * s.sign;
     }
-    // qdd_des = M^-1 (H F_des - C qd - G) and M^-1 a_c in one pass.
-    Rhs6<2> rhs;
+    // qdd_des = M^-1 (H F_des + d^ - C qd - G), M^-1 a_c and M^-1 in one pass.
+    Rhs6<8> rhs;
     rhs.col(0) = generalised_force - terms.C_qd - terms.G;
     rhs.col(1) = x->a_c;
-    x->inertia.SolveInPlace<2>(&rhs);
+    rhs.rightCols<6>().setIdentity();
+    x->inertia.SolveInPlace<8>(&rhs);
+    x->m_inv = rhs.rightCols<6>();
+    // dh_v,i/dd = sign_i (M^-1)_(axis, :): the worst case per axis.
+    Vector6d axis_bound = Vector6d::Zero();
+    if (robust) axis_bound.noalias() = x->m_inv.cwiseAbs() * d_bound;
     double psi = e.h_vel;
     for (int i = 0; i < c.num_velocity; ++i) {
       const size_t k = static_cast<size_t>(i);
       const VelocityBarrierSpec& s = c.velocity[k];
-      e.dh_velocity[k] = s.sign * rhs(s.axis, 0);
+      e.dh_velocity[k] = s.sign * rhs(s.axis, 0) - axis_bound(s.axis);
+      if (s.recovery_of >= 0) e.dh_velocity[k] += recovery_slope[k] * s.sign * qd(s.axis);
       psi += s.alpha_v * e.w_velocity[k] * e.dh_velocity[k];
     }
     e.psi_v = psi - c.velocity_margin;

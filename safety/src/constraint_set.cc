@@ -1,5 +1,7 @@
 #include "stewart/safety/constraint_set.h"
 
+#include <cmath>
+
 #include "stewart/common/check.h"
 
 namespace stewart::safety {
@@ -50,13 +52,51 @@ ConstraintSet BuildConstraintSet(const PlatformParams& platform, const SafetyCon
     STEWART_CHECK_INPUT(c.num_velocity < kMaxVelocityBarriers, "safety.velocity_limits",
                         "too many velocity limits (axis listed twice?)");
     STEWART_CHECK_INPUT(alpha_v > 0.0, "safety constraint " + name, "alpha_v must be positive");
-    c.velocity[static_cast<size_t>(c.num_velocity++)] = {axis, sign, limit, alpha_v, name};
+    VelocityBarrierSpec& v = c.velocity[static_cast<size_t>(c.num_velocity++)];
+    v = VelocityBarrierSpec{};
+    v.axis = axis;
+    v.sign = sign;
+    v.limit = limit;
+    v.alpha_v = alpha_v;
+    v.name = name;
   };
   for (const VelocityLimitConfig& l : safety.velocity_limits) {
     const std::string axis = std::string(kAxisNames[static_cast<size_t>(l.axis)]) + "d";
     if (l.lower) add_velocity(l.axis, 1.0, *l.lower, l.alpha_v, axis + "_lower");
     if (l.upper) add_velocity(l.axis, -1.0, *l.upper, l.alpha_v, axis + "_upper");
   }
+  // Recovery barriers: relative degree one in F (unlike the energy barrier,
+  // whose F gradient -H^T qd vanishes at rest), so the set stays attractive
+  // from outside. kappa doubles as their class-K gain: the position error
+  // then obeys h'' + 2 kappa h' + kappa^2 h >= 0 (critically damped).
+  const double kappa = safety.recovery_gain_per_s;
+  STEWART_CHECK_INPUT(kappa >= 0.0, "safety.recovery_gain_per_s", "must be >= 0");
+  if (kappa > 0.0) {
+    const int num_position = c.num_position;
+    for (int i = 0; i < num_position; ++i) {
+      const PositionBarrierSpec& p = c.position[static_cast<size_t>(i)];
+      if (p.source != PositionSource::kAxis) continue;
+      // The speed back stays within the axis's velocity limits (else the
+      // recovery and velocity barriers would leave no feasible velocity).
+      double slowest_limit = 0.0;
+      for (const VelocityLimitConfig& l : safety.velocity_limits) {
+        if (l.axis != p.index) continue;
+        for (const std::optional<double>& v : {l.lower, l.upper}) {
+          if (v && (slowest_limit == 0.0 || std::fabs(*v) < slowest_limit)) {
+            slowest_limit = std::fabs(*v);
+          }
+        }
+      }
+      add_velocity(p.index, p.sign, 0.0, kappa, p.name + "_recovery");
+      VelocityBarrierSpec& r = c.velocity[static_cast<size_t>(c.num_velocity - 1)];
+      r.recovery_of = i;
+      r.recovery_gain_per_s = kappa;
+      r.recovery_speed = 0.5 * slowest_limit;
+      c.has_recovery = true;
+    }
+  }
+  STEWART_CHECK_INPUT(safety.disturbance_sigma >= 0.0, "safety.disturbance_sigma", "must be >= 0");
+  c.disturbance_sigma = safety.use_disturbance_estimate ? safety.disturbance_sigma : 0.0;
   return c;
 }
 

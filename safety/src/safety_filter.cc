@@ -38,7 +38,7 @@ TwoConstraintProblem MakeProblem(const ConstraintSet& c, const BarrierEvaluation
     p.g_p.noalias() = map.transpose() * b.g_p;
     p.g_v.noalias() = map.transpose() * b.g_v;
   }
-  p.has_p = c.num_position > 0;
+  p.has_p = c.num_position > 0 && !b.outside_position_set;
   p.has_v = c.num_velocity > 0;
   return p;
 }
@@ -71,6 +71,7 @@ SafetyFilter::SafetyFilter(const PlatformParams& platform, const SafetyConfig& s
       force_limit_n_(actuators.force_limit_n),
       fallback_(safety.fallback),
       stop_time_s_(safety.stop_time_s),
+      use_disturbance_(safety.use_disturbance_estimate),
       reference_(reference) {
   STEWART_CHECK_INPUT(force_limit_n_ > 0.0 || !force_limits_, "actuators.force_limit_n",
                       "must be positive when safety.force_limits_enabled");
@@ -87,6 +88,12 @@ void SafetyFilter::set_variant(SafetyVariant variant) {
 
 Vector6d SafetyFilter::Step(const Vector6d& q, const Vector6d& qd, const Vector6d& f_des,
                             SafetyDiagnostics* diagnostics) {
+  return Step(q, qd, f_des, GeneralizedDisturbance{}, diagnostics);
+}
+
+Vector6d SafetyFilter::Step(const Vector6d& q, const Vector6d& qd, const Vector6d& f_des,
+                            const GeneralizedDisturbance& disturbance,
+                            SafetyDiagnostics* diagnostics) {
   // The one clock read pair of a step: compute_ns covers the model terms and
   // the filter (StepWithTerms is not timed).
   const auto start = std::chrono::steady_clock::now();
@@ -96,7 +103,7 @@ Vector6d SafetyFilter::Step(const Vector6d& q, const Vector6d& qd, const Vector6
   } else {
     terms.M.setConstant(NAN);  // marks the terms invalid for StepWithTerms
   }
-  const Vector6d f_safe = StepWithTerms(terms, q, qd, f_des, diagnostics);
+  const Vector6d f_safe = StepWithTerms(terms, q, qd, f_des, disturbance, diagnostics);
   diagnostics->compute_ns =
       std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - start)
           .count();
@@ -105,6 +112,13 @@ Vector6d SafetyFilter::Step(const Vector6d& q, const Vector6d& qd, const Vector6
 
 Vector6d SafetyFilter::StepWithTerms(const DynamicsTerms& terms, const Vector6d& q,
                                      const Vector6d& qd, const Vector6d& f_des,
+                                     SafetyDiagnostics* d) const {
+  return StepWithTerms(terms, q, qd, f_des, GeneralizedDisturbance{}, d);
+}
+
+Vector6d SafetyFilter::StepWithTerms(const DynamicsTerms& terms, const Vector6d& q,
+                                     const Vector6d& qd, const Vector6d& f_des,
+                                     const GeneralizedDisturbance& disturbance,
                                      SafetyDiagnostics* d) const {
   d->variant = variant_;
   d->flags = 0;
@@ -118,12 +132,18 @@ Vector6d SafetyFilter::StepWithTerms(const DynamicsTerms& terms, const Vector6d&
 
   const bool state_valid = StateAndTermsFinite(q, qd, terms);
   // NaN compares false: this also rejects non-finite entries.
-  const bool input_valid = state_valid && (f_des.array().abs() <= kMaxInputForceN).all();
+  // A non-finite disturbance estimate is an invalid state, like a NaN in q.
+  const bool disturbance_valid =
+      !use_disturbance_ || (disturbance.force_n.allFinite() && disturbance.std_n.allFinite() &&
+                            (disturbance.std_n.array() >= 0.0).all());
+  const bool input_valid =
+      state_valid && disturbance_valid && (f_des.array().abs() <= kMaxInputForceN).all();
   bool ok = input_valid;
   FilterWorkspace& ws = workspace_;
   const StepInput in{terms, qd, f_des, d->barriers};
   if (ok) {
-    EvaluateBarriers(constraints_, q, qd, terms, f_des, leg_friction_nspm_, &d->barriers,
+    EvaluateBarriers(constraints_, q, qd, terms, f_des, leg_friction_nspm_,
+                     use_disturbance_ ? disturbance : GeneralizedDisturbance{}, &d->barriers,
                      &ws.barrier);
     ok = BarriersFinite(d->barriers) &&
          (metric_ == CorrectionMetric::kForce || ws.barrier.inertia_valid);
@@ -157,6 +177,7 @@ Vector6d SafetyFilter::StepWithTerms(const DynamicsTerms& terms, const Vector6d&
     d->infeasible = input_valid;
     d->f_safe = SafeStop(terms, qd, state_valid);
   }
+  if (d->barriers.outside_safe_set) d->flags |= kFlagOutsideSafeSet;
   const Vector6d correction = d->f_safe - f_des;
   d->correction_norm = correction.allFinite() ? correction.norm() : 0.0;
   if (!(d->correction_norm == 0.0)) d->flags |= kFlagFilterActive;
@@ -229,7 +250,7 @@ void SafetyFilter::SolveUnlimited(const StepInput& in, const FilterWorkspace& ws
   TwoConstraintGram gram;
   gram.psi_p = b.psi_p;
   gram.psi_v = b.psi_v;
-  gram.has_p = constraints_.num_position > 0;
+  gram.has_p = constraints_.num_position > 0 && !b.outside_position_set;
   gram.has_v = constraints_.num_velocity > 0;
   if (metric_ == CorrectionMetric::kForce) {
     gram.pp = b.g_p.squaredNorm();

@@ -6,7 +6,10 @@
 namespace stewart::safety {
 namespace {
 
-bool StateFinite(const StateSample& s) { return s.q.allFinite() && s.qd.allFinite(); }
+bool StateFinite(const StateSample& s) {
+  return s.q.allFinite() && s.qd.allFinite() && s.disturbance.allFinite() &&
+         s.disturbance_std.allFinite();
+}
 
 }  // namespace
 
@@ -107,8 +110,11 @@ bool SafetyProcess::OnNominal(const ForceCommand& nominal, SafetyOutput* out) {
 }
 
 SafetyOutput SafetyProcess::Filter(const StateSample& state, const ForceCommand& nominal) {
-  const Vector6d f_safe = filter_.Step(state.q, state.qd, nominal.force_n, &diagnostics_);
+  const GeneralizedDisturbance disturbance{state.disturbance, state.disturbance_std};
+  const Vector6d f_safe =
+      filter_.Step(state.q, state.qd, nominal.force_n, disturbance, &diagnostics_);
   if (diagnostics_.flags & kFlagInvalidInput) counters_->Reject("invalid_nominal");
+  if (diagnostics_.flags & kFlagOutsideSafeSet) counters_->Count("outside_safe_set");
   return Emit(f_safe, nominal.sample_utime, 0);
 }
 

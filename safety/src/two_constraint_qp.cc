@@ -20,6 +20,8 @@ Gram MakeGram(const TwoConstraintGram& pr) {
   Gram g{pr.pp, pr.vv, pr.pv, false, false};
   g.p_zero = !pr.has_p || !(g.pp > kZeroNormal * kZeroNormal);
   g.v_zero = !pr.has_v || !(g.vv > kZeroNormal * kZeroNormal);
+  // An absent group has no normal: the other's correction cannot move it.
+  if (!pr.has_p || !pr.has_v) g.pv = 0.0;
   return g;
 }
 

@@ -67,7 +67,7 @@ bool SafetyFilter::PoseUncomposedQp(const StepInput& in, ConditionGroups groups,
   if (!force_metric && !SolvePartialPivot6(map, &qp.x0)) qp.x0.setConstant(NAN);
   bool posable = true;
 
-  if (c.num_position > 0 && groups != ConditionGroups::kVelocityOnly) {
+  if (c.num_position > 0 && groups != ConditionGroups::kVelocityOnly && !b.outside_position_set) {
     // dh_D,i/dF = -H^T qd for every position barrier (the power term): the
     // rows differ only by alpha_i and their offsets.
     Vector6d g = -(terms.H.transpose() * in.qd);

@@ -444,18 +444,21 @@ ControllerReplayResult ReplayController(const StackConfig& config, const Scenari
 
 namespace {
 
-// q, qd, q_std, qd_std of a state in one array.
-std::array<double, 24> StateValues(const state_t& s) {
-  std::array<double, 24> v{};
+// q, qd, q_std, qd_std, disturbance and its std of a state in one array.
+std::array<double, 36> StateValues(const state_t& s) {
+  std::array<double, 36> v{};
   std::copy(std::begin(s.q), std::end(s.q), v.begin());
   std::copy(std::begin(s.qd), std::end(s.qd), v.begin() + 6);
   std::copy(std::begin(s.q_std), std::end(s.q_std), v.begin() + 12);
   std::copy(std::begin(s.qd_std), std::end(s.qd_std), v.begin() + 18);
+  std::copy(std::begin(s.disturbance), std::end(s.disturbance), v.begin() + 24);
+  std::copy(std::begin(s.disturbance_std), std::end(s.disturbance_std), v.begin() + 30);
   return v;
 }
 
 bool EstimateFinite(const state_t& s) {
-  return AllFinite(s.q) && AllFinite(s.qd) && AllFinite(s.q_std) && AllFinite(s.qd_std);
+  return AllFinite(s.q) && AllFinite(s.qd) && AllFinite(s.q_std) && AllFinite(s.qd_std) &&
+         AllFinite(s.disturbance) && AllFinite(s.disturbance_std);
 }
 
 }  // namespace

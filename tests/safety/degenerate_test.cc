@@ -30,14 +30,66 @@ TEST(Degenerate, AtRestThePositionNormalIsZeroAndOnlyVelocityActs) {
   EXPECT_EQ(d.mu_p, 0.0);
 }
 
-TEST(Degenerate, AtRestOutsideThePositionSetIsInfeasibleAndFlagged) {
-  SafetyFilter filter = MakeRichFilter();
+// At rest outside a position limit the energy barrier's F gradient -H^T qd
+// vanishes: its condition would demand an unbounded force (or none at all).
+// The filter leaves the position group out there and the recovery barrier
+// h_r = -xd + phi(0.11 - x) pulls the platform back, with a force that stays
+// bounded and continuous as the velocity noise goes to zero.
+TEST(Degenerate, AtRestOutsideThePositionSetSteersBackAndIsFlagged) {
+  for (const SafetyVariant variant : {SafetyVariant::kClosedForm, SafetyVariant::kUncomposed}) {
+    SafetyFilter filter = MakeRichFilter(false, variant);
+    Vector6d q = DefaultConfig().home_pose;
+    q(0) = 0.12;  // 10 mm beyond x <= 0.11
+    const VelocityBarrierSpec* recovery = nullptr;
+    for (int i = 0; i < filter.constraints().num_velocity; ++i) {
+      const VelocityBarrierSpec& v = filter.constraints().velocity[static_cast<size_t>(i)];
+      if (v.name == "x_upper_recovery") recovery = &v;
+    }
+    ASSERT_NE(recovery, nullptr);
+    EXPECT_GT(recovery->recovery_speed, 0.0);
+    // The recovery condition asks -xdd >= -phi(-10 mm) = v_r tanh(kappa 10 mm
+    // / v_r) at rest (the group's unit class-K rate, docs/safety.md).
+    double phi = 0.0, slope = 0.0;
+    RecoveryTarget(*recovery, -0.01, &phi, &slope);
+    std::mt19937 rng(5);
+    std::normal_distribution<double> noise(0.0, 1.0);
+    Vector6d f_at_rest = Vector6d::Zero();
+    for (const double qd_size : {0.0, 1e-9, 1e-6, 1e-4}) {
+      Vector6d qd;
+      for (int i = 0; i < 6; ++i) qd(i) = qd_size * noise(rng);
+      const DynamicsTerms t = EvaluateDynamics(DefaultConfig().platform, q, qd);
+      SafetyDiagnostics d;
+      const Vector6d f = filter.Step(q, qd, HoverForce(q), &d);
+      const std::string where = ToString(variant) + " |qd| ~ " + std::to_string(qd_size);
+      ASSERT_TRUE(f.allFinite()) << where;
+      EXPECT_TRUE(d.barriers.outside_position_set) << where;
+      EXPECT_TRUE(d.flags & kFlagOutsideSafeSet) << where;
+      EXPECT_FALSE(d.infeasible) << where;
+      EXPECT_FALSE(d.flags & kFlagFallback) << where;
+      EXPECT_TRUE(d.flags & kFlagFilterActive) << where;  // never F_des itself
+      const Vector6d qdd = ForwardDynamics(
+          t, f + LegViscousFriction(filter.leg_friction_nspm(), t.H.transpose() * qd));
+      EXPECT_LT(qdd(0), 0.999 * phi) << where;
+      EXPECT_LE(f.cwiseAbs().maxCoeff(), 100.0) << where;
+      if (qd_size == 0.0) f_at_rest = f;
+      // Continuous in qd: velocity noise does not kick the command.
+      EXPECT_LT((f - f_at_rest).cwiseAbs().maxCoeff(), 1e3 * qd_size + 1e-9) << where;
+    }
+  }
+}
+
+TEST(Degenerate, WithoutRecoveryBarriersAtRestOutsideIsInfeasibleAndFlagged) {
+  SafetyConfig s = RichSafetyConfig();
+  s.recovery_gain_per_s = 0.0;
+  SafetyFilter filter(DefaultConfig().platform, s, DefaultConfig().actuators);
   Vector6d q = DefaultConfig().home_pose;
   q(0) = 0.12;  // beyond x <= 0.11: h_pos < 0 and g_p = 0
   SafetyDiagnostics d;
   const Vector6d f = filter.Step(q, Vector6d::Zero(), HoverForce(q), &d);
   EXPECT_TRUE(f.allFinite());
   EXPECT_LT(d.barriers.psi_p, 0.0);
+  EXPECT_FALSE(d.barriers.outside_position_set);
+  EXPECT_TRUE(d.flags & kFlagOutsideSafeSet);
   EXPECT_TRUE(d.infeasible);
   EXPECT_TRUE(d.flags & kFlagInfeasible);
   EXPECT_EQ(d.filter_case, FilterCase::kInfeasible);

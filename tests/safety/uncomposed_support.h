@@ -29,7 +29,8 @@ inline SingleBarrierConditions EvaluateSingleBarrierConditions(const SafetyFilte
   const ConstraintSet& c = filter.constraints();
   BarrierEvaluation e;
   BarrierIntermediates x;
-  EvaluateBarriers(c, q, qd, terms, f, filter.leg_friction_nspm(), &e, &x);
+  EvaluateBarriers(c, q, qd, terms, f, filter.leg_friction_nspm(), GeneralizedDisturbance{}, &e,
+                   &x);
   SingleBarrierConditions s;
   s.num_position = c.num_position;
   s.num_velocity = c.num_velocity;

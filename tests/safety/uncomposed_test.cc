@@ -148,105 +148,117 @@ TEST(Uncomposed, KktWithRobustMargins) {
 
 // There the composed condition tends to that barrier's own as k grows
 // (h_c -> alpha_i h_i, w_i -> 1), so the two filters must agree.
+// Run on the paper's barriers (recovery barriers off: every case occurs
+// often) and with the recovery barriers (they bind near a position limit, so
+// fewer states have one clearly smallest margin per group).
 TEST(Uncomposed, AgreesWithTheComposedFilterAsKGrows) {
   const PlatformParams& platform = DefaultConfig().platform;
-  for (CorrectionMetric metric : {CorrectionMetric::kForce, CorrectionMetric::kAcceleration}) {
-    const SafetyConfig base = UncomposedConfig(false, metric);
-    SafetyFilter uncomposed(platform, base, DefaultConfig().actuators);
-    // (k_position 1/J, k_velocity s/m), from soft to far sharper than shipped.
-    const std::array<std::pair<double, double>, 5> ks = {
-        {{2e3, 3e2}, {2e4, 3e3}, {2e5, 3e4}, {2e6, 3e5}, {2e7, 3e6}}};
-    std::array<double, 5> sum_err{};
-    std::array<SafetyFilter, 5> composed = [&] {
-      auto make = [&](size_t i) {
-        SafetyConfig s = base;
-        s.variant = SafetyVariant::kClosedForm;
-        s.k_position = ks[i].first;
-        s.k_velocity = ks[i].second;
-        return SafetyFilter(platform, s, DefaultConfig().actuators);
-      };
-      return std::array<SafetyFilter, 5>{make(0), make(1), make(2), make(3), make(4)};
-    }();
-    const ConstraintSet& c = uncomposed.constraints();
-    std::mt19937 rng(metric == CorrectionMetric::kForce ? 41 : 43);
-    std::array<int, 4> cases{};
-    int selected = 0;
-    for (int n = 0; n < 30000 && selected < 1500; ++n) {
-      NearOneLimit x;
-      // Velocity barrier alone; position barrier alone; both (the other
-      // axes' motion turns the position normal away from the velocity one).
-      // Most velocity-type draws bind a position barrier too, so they get
-      // two slots of four.
-      const bool drawn = n % 4 < 2    ? DrawNearOneLimit(&rng, &x)
-                         : n % 4 == 2 ? DrawNearPositionLimit(uncomposed, 1e-5, &rng, &x)
-                                      : DrawNearPositionLimit(uncomposed, 2e-3, &rng, &x);
-      if (!drawn) continue;
-      SafetyDiagnostics du;
-      const Vector6d fu = uncomposed.StepWithTerms(x.terms, x.q, x.qd, x.f_des, &du);
-      if (du.infeasible) continue;
-      // The smallest scaled margin of each group by a clear gap (k_max * gap
-      // > 746: the other weights underflow to exactly 0), and only it may
-      // carry a multiplier.
-      auto single = [](const double* alpha_h, const double* mu, int count, double gap) {
-        int smallest = 0;
-        for (int i = 1; i < count; ++i) smallest = alpha_h[i] < alpha_h[smallest] ? i : smallest;
-        for (int i = 0; i < count; ++i) {
-          if (i == smallest) continue;
-          if (alpha_h[i] - alpha_h[smallest] < gap || mu[i] != 0.0) return false;
+  for (const bool recovery : {false, true}) {
+    for (CorrectionMetric metric : {CorrectionMetric::kForce, CorrectionMetric::kAcceleration}) {
+      SafetyConfig base = UncomposedConfig(false, metric);
+      if (!recovery) base.recovery_gain_per_s = 0.0;
+      SCOPED_TRACE(recovery ? "with recovery barriers" : "paper's barriers");
+      SafetyFilter uncomposed(platform, base, DefaultConfig().actuators);
+      // (k_position 1/J, k_velocity s/m), from soft to far sharper than shipped.
+      const std::array<std::pair<double, double>, 5> ks = {
+          {{2e3, 3e2}, {2e4, 3e3}, {2e5, 3e4}, {2e6, 3e5}, {2e7, 3e6}}};
+      std::array<double, 5> sum_err{};
+      std::array<SafetyFilter, 5> composed = [&] {
+        auto make = [&](size_t i) {
+          SafetyConfig s = base;
+          s.variant = SafetyVariant::kClosedForm;
+          s.k_position = ks[i].first;
+          s.k_velocity = ks[i].second;
+          return SafetyFilter(platform, s, DefaultConfig().actuators);
+        };
+        return std::array<SafetyFilter, 5>{make(0), make(1), make(2), make(3), make(4)};
+      }();
+      const ConstraintSet& c = uncomposed.constraints();
+      std::mt19937 rng(metric == CorrectionMetric::kForce ? 41 : 43);
+      std::array<int, 4> cases{};
+      int selected = 0;
+      for (int n = 0; n < 30000 && selected < 1500; ++n) {
+        NearOneLimit x;
+        // Velocity barrier alone; position barrier alone; both (the other
+        // axes' motion turns the position normal away from the velocity one).
+        // Most velocity-type draws bind a position barrier too, so they get
+        // two slots of four.
+        const bool drawn = n % 4 < 2    ? DrawNearOneLimit(&rng, &x)
+                           : n % 4 == 2 ? DrawNearPositionLimit(uncomposed, 1e-5, &rng, &x)
+                                        : DrawNearPositionLimit(uncomposed, 2e-3, &rng, &x);
+        if (!drawn) continue;
+        SafetyDiagnostics du;
+        const Vector6d fu = uncomposed.StepWithTerms(x.terms, x.q, x.qd, x.f_des, &du);
+        if (du.infeasible) continue;
+        // The smallest scaled margin of each group by a clear gap (k_max * gap
+        // > 746: the other weights underflow to exactly 0), and only it may
+        // carry a multiplier.
+        auto single = [](const double* alpha_h, const double* mu, int count, double gap) {
+          int smallest = 0;
+          for (int i = 1; i < count; ++i) smallest = alpha_h[i] < alpha_h[smallest] ? i : smallest;
+          for (int i = 0; i < count; ++i) {
+            if (i == smallest) continue;
+            if (alpha_h[i] - alpha_h[smallest] < gap || mu[i] != 0.0) return false;
+          }
+          return true;
+        };
+        if (!single(du.barriers.alpha_h_position.data(), du.mu_position.data(), c.num_position,
+                    1e-4) ||
+            !single(du.barriers.alpha_h_velocity.data(), du.mu_velocity.data(), c.num_velocity,
+                    5e-4)) {
+          continue;
         }
-        return true;
-      };
-      if (!single(du.barriers.alpha_h_position.data(), du.mu_position.data(), c.num_position,
-                  1e-4) ||
-          !single(du.barriers.alpha_h_velocity.data(), du.mu_velocity.data(), c.num_velocity,
-                  5e-4)) {
-        continue;
+        // The other rows must have slack at F* (the composed QP at large k
+        // does not contain them).
+        const SingleBarrierConditions at_f =
+            EvaluateSingleBarrierConditions(uncomposed, x.q, x.qd, x.terms, fu);
+        bool slack = true;
+        for (int i = 0; i < c.num_position; ++i) {
+          const size_t k = static_cast<size_t>(i);
+          if (du.mu_position[k] == 0.0 && at_f.psi_position[k] < 1e-6) slack = false;
+        }
+        for (int i = 0; i < c.num_velocity; ++i) {
+          const size_t k = static_cast<size_t>(i);
+          if (du.mu_velocity[k] == 0.0 && at_f.psi_velocity[k] < 1e-6) slack = false;
+        }
+        if (!slack) continue;
+        ++selected;
+        ++cases[static_cast<size_t>(du.filter_case)];
+        for (size_t i = 0; i < ks.size(); ++i) {
+          SafetyDiagnostics dc;
+          const Vector6d fc = composed[i].StepWithTerms(x.terms, x.q, x.qd, x.f_des, &dc);
+          const double err = RelativeError(fc, fu);
+          sum_err[i] += err;
+          if (i + 1 == ks.size()) {
+            EXPECT_LE(err, 1e-9) << "sample " << n << "\ncomposed   " << fc.transpose()
+                                 << "\nuncomposed " << fu.transpose();
+            EXPECT_EQ(dc.filter_case, du.filter_case) << "sample " << n;
+          }
+        }
       }
-      // The other rows must have slack at F* (the composed QP at large k
-      // does not contain them).
-      const SingleBarrierConditions at_f =
-          EvaluateSingleBarrierConditions(uncomposed, x.q, x.qd, x.terms, fu);
-      bool slack = true;
-      for (int i = 0; i < c.num_position; ++i) {
-        const size_t k = static_cast<size_t>(i);
-        if (du.mu_position[k] == 0.0 && at_f.psi_position[k] < 1e-6) slack = false;
-      }
-      for (int i = 0; i < c.num_velocity; ++i) {
-        const size_t k = static_cast<size_t>(i);
-        if (du.mu_velocity[k] == 0.0 && at_f.psi_velocity[k] < 1e-6) slack = false;
-      }
-      if (!slack) continue;
-      ++selected;
-      ++cases[static_cast<size_t>(du.filter_case)];
+      std::printf(
+          "%s metric: %d states (cases none %d pos %d vel %d both %d); mean rel. difference "
+          "composed vs uncomposed for (k_position, k_velocity) = ",
+          ToString(metric).c_str(), selected, cases[0], cases[1], cases[2], cases[3]);
       for (size_t i = 0; i < ks.size(); ++i) {
-        SafetyDiagnostics dc;
-        const Vector6d fc = composed[i].StepWithTerms(x.terms, x.q, x.qd, x.f_des, &dc);
-        const double err = RelativeError(fc, fu);
-        sum_err[i] += err;
-        if (i + 1 == ks.size()) {
-          EXPECT_LE(err, 1e-9) << "sample " << n << "\ncomposed   " << fc.transpose()
-                               << "\nuncomposed " << fu.transpose();
-          EXPECT_EQ(dc.filter_case, du.filter_case) << "sample " << n;
-        }
+        std::printf("(%.0e, %.0e): %.3g%s", ks[i].first, ks[i].second, sum_err[i] / selected,
+                    i + 1 < ks.size() ? ", " : "\n");
+      }
+      EXPECT_GE(selected, recovery ? 200 : 500);
+      EXPECT_GT(cases[1], 20);
+      EXPECT_GT(cases[2], 20);
+      if (!recovery) {
+        EXPECT_GT(cases[3], 20);
+      }
+      // The difference shrinks with k, from visible to rounding.
+      for (size_t i = 1; i < ks.size(); ++i) {
+        EXPECT_TRUE(sum_err[i] < sum_err[i - 1] || sum_err[i] / selected < 1e-12)
+            << "k level " << i;
+      }
+      if (!recovery) {
+        EXPECT_GT(sum_err[0] / selected, 1e-4);
       }
     }
-    std::printf(
-        "%s metric: %d states (cases none %d pos %d vel %d both %d); mean rel. difference "
-        "composed vs uncomposed for (k_position, k_velocity) = ",
-        ToString(metric).c_str(), selected, cases[0], cases[1], cases[2], cases[3]);
-    for (size_t i = 0; i < ks.size(); ++i) {
-      std::printf("(%.0e, %.0e): %.3g%s", ks[i].first, ks[i].second, sum_err[i] / selected,
-                  i + 1 < ks.size() ? ", " : "\n");
-    }
-    EXPECT_GE(selected, 500);
-    EXPECT_GT(cases[1], 20);
-    EXPECT_GT(cases[2], 20);
-    EXPECT_GT(cases[3], 20);
-    // The difference shrinks with k, from visible to rounding.
-    for (size_t i = 1; i < ks.size(); ++i) {
-      EXPECT_TRUE(sum_err[i] < sum_err[i - 1] || sum_err[i] / selected < 1e-12) << "k level " << i;
-    }
-    EXPECT_GT(sum_err[0] / selected, 1e-4);
   }
 }
 
@@ -272,34 +284,29 @@ TEST(UncomposedDegenerate, AtRestOnlyVelocityRowsAct) {
   }
 }
 
-TEST(UncomposedDegenerate, AtRestOutsideThePositionSetIsInfeasibleAndFlagged) {
+TEST(UncomposedDegenerate, AtRestOutsideThePositionSetMeetsEveryVelocityRow) {
   Vector6d q = DefaultConfig().home_pose;
-  q(0) = 0.12;  // beyond x <= 0.11 at rest: a violated row with a zero normal
+  q(0) = 0.12;  // beyond x <= 0.11 at rest: the position rows are left out
   const DynamicsTerms t = EvaluateDynamics(DefaultConfig().platform, q, Vector6d::Zero());
-  // Hover, and a push along +x that the velocity rows must stop.
+  // Hover, and a push along +x that the velocity and recovery rows must stop.
   for (const Vector6d& f_des :
        {HoverForce(q), Vector6d(InverseDynamics(t, Vector6d::Unit(0) * 5.0))}) {
-    SafetyFilter filter = MakeRichFilter(false, SafetyVariant::kUncomposed);
-    SafetyDiagnostics d;
-    const Vector6d f = filter.Step(q, Vector6d::Zero(), f_des, &d);
-    EXPECT_TRUE(f.allFinite());
-    EXPECT_TRUE(d.infeasible);
-    EXPECT_TRUE(d.flags & kFlagInfeasible);
-    EXPECT_EQ(d.filter_case, FilterCase::kInfeasible);
-    // As the closed form: the velocity rows are still enforced.
-    const SingleBarrierConditions at_f =
-        EvaluateSingleBarrierConditions(filter, q, Vector6d::Zero(), t, f);
-    for (int i = 0; i < at_f.num_velocity; ++i) {
-      EXPECT_GE(at_f.psi_velocity[static_cast<size_t>(i)], -1e-9);
+    for (const bool force_limits : {false, true}) {
+      SafetyFilter filter = MakeRichFilter(force_limits, SafetyVariant::kUncomposed);
+      SafetyDiagnostics d;
+      const Vector6d f = filter.Step(q, Vector6d::Zero(), f_des, &d);
+      EXPECT_TRUE(f.allFinite());
+      EXPECT_FALSE(d.infeasible);
+      EXPECT_FALSE(d.flags & kFlagFallback);
+      EXPECT_TRUE(d.flags & kFlagOutsideSafeSet);
+      // Every velocity row, the recovery rows among them, holds exactly.
+      const SingleBarrierConditions at_f =
+          EvaluateSingleBarrierConditions(filter, q, Vector6d::Zero(), t, f);
+      for (int i = 0; i < at_f.num_velocity; ++i) {
+        EXPECT_GE(at_f.psi_velocity[static_cast<size_t>(i)], -1e-9) << i;
+      }
+      EXPECT_LE(f.cwiseAbs().maxCoeff(), DefaultConfig().actuators.force_limit_n + 1e-9);
     }
-    // Force-limited: as the composed force-limited filter, the safe stop.
-    SafetyFilter limited = MakeRichFilter(true, SafetyVariant::kUncomposed);
-    const Vector6d fl = limited.Step(q, Vector6d::Zero(), f_des, &d);
-    EXPECT_TRUE(fl.allFinite());
-    EXPECT_TRUE(d.flags & kFlagFallback);
-    EXPECT_TRUE(d.flags & kFlagInfeasible);
-    EXPECT_EQ(d.filter_case, FilterCase::kFallback);
-    EXPECT_LE(fl.cwiseAbs().maxCoeff(), DefaultConfig().actuators.force_limit_n);
   }
 }
 

@@ -168,13 +168,14 @@ namespace {
 // into end-stop chatter that stalls the explicit integrator (ARKODE gave up
 // with ARK_ERR_FAILURE before the fallback existed); the plant integrates
 // those intervals with BDF and the run completes.
-TEST(Campaign, EndStopChatterFallsBackToTheStiffIntegratorAndTheRunCompletes) {
+// A truth within the bounds runs its whole scenario: whatever the stack does
+// with it, the plant's integrator survives (end-stop chatter falls back to
+// the implicit method: PlantEndStop.ChatterFallsBackToTheStiffIntegrator).
+TEST(Campaign, BoundsRunCompletes) {
   const CampaignSpec spec = MakeCampaignSpec(DefaultConfigPath(), "paper", kBounds, 1, 0.0);
   const CampaignRow row = RunCampaignRow(spec, 7, nullptr);
   EXPECT_TRUE(row.summary.completed) << row.summary.failure;
   EXPECT_EQ(row.summary.ticks, 40000);
-  EXPECT_GT(row.summary.stiff_fallbacks, 0);
-  EXPECT_GT(row.summary.endstop_hits, 0);
 }
 
 }  // namespace

@@ -21,6 +21,10 @@ struct StateSample {
   Eigen::Matrix<double, 6, 1> qd = Eigen::Matrix<double, 6, 1>::Zero();
   Eigen::Matrix<double, 6, 1> q_std = Eigen::Matrix<double, 6, 1>::Zero();
   Eigen::Matrix<double, 6, 1> qd_std = Eigen::Matrix<double, 6, 1>::Zero();
+  /// The estimated model error d and its one-sigma uncertainty
+  /// (model/disturbance.h; N, N m per rad). Zero for ground truth.
+  Eigen::Matrix<double, 6, 1> disturbance = Eigen::Matrix<double, 6, 1>::Zero();
+  Eigen::Matrix<double, 6, 1> disturbance_std = Eigen::Matrix<double, 6, 1>::Zero();
   int32_t status = 0;  ///< kState* bits
 };
 
@@ -53,5 +57,7 @@ constexpr int32_t kCommandStaleInput = 8;
 constexpr int32_t kCommandInvalidInput = 16;
 constexpr int32_t kCommandSetpointRejected = 32;
 constexpr int32_t kCommandForceLimited = 64;
+/// A limit is exceeded on the state the command was filtered at.
+constexpr int32_t kCommandOutsideSafeSet = 128;
 
 }  // namespace stewart

@@ -22,7 +22,8 @@ static_assert(kCommandFilterActive == force_command_t::FLAG_FILTER_ACTIVE &&
                   kCommandStaleInput == force_command_t::FLAG_STALE_INPUT &&
                   kCommandInvalidInput == force_command_t::FLAG_INVALID_INPUT &&
                   kCommandSetpointRejected == force_command_t::FLAG_SETPOINT_REJECTED &&
-                  kCommandForceLimited == force_command_t::FLAG_FORCE_LIMITED,
+                  kCommandForceLimited == force_command_t::FLAG_FORCE_LIMITED &&
+                  kCommandOutsideSafeSet == force_command_t::FLAG_OUTSIDE_SAFE_SET,
               "signals.h and force_command_t.FLAG_* must agree");
 
 /// For each message, the library signal it carries and the fields both share
@@ -35,7 +36,8 @@ struct SignalOf<state_t> {
   using Type = StateSample;
   template <typename State>
   static auto Fields(State& s) {
-    return std::tie(s.utime, s.seq, s.sample_utime, s.q, s.qd, s.q_std, s.qd_std, s.status);
+    return std::tie(s.utime, s.seq, s.sample_utime, s.q, s.qd, s.q_std, s.qd_std, s.disturbance,
+                    s.disturbance_std, s.status);
   }
 };
 

@@ -13,11 +13,21 @@
 //   h_c = LSE_k(alpha_i h_i),  psi = sum_i alpha_i w_i dh_i(F_des) + h_c,
 //   g = sum_i alpha_i w_i dh_i/dF
 // so g_p = (sum_i alpha_i w_i) (-H^T qd) and g_v = H^T M^-1 sum_i alpha_i w_i a_i.
+//
+// Model error (docs/safety.md "Model error"): with the disturbance estimate
+// d^ of M qdd + C qd + G = H F + d (model/disturbance.h), H F becomes
+// H F + d^ above, and each dh_i is taken at the worst d within k_sigma
+// standard deviations of d^ (entry by entry, so for any correlation):
+//   dh_D,i -= k_sigma sum_j |qd_j| sigma_j,
+//   dh_v,i -= k_sigma sum_j |(M^-1 a_i)_j| sigma_j.
+// Recovery barrier of an axis position limit (constraint_set.h), velocity
+// group: h_r = sign qd_j + kappa h(q), dh_r = sign qdd_j + kappa sign qd_j.
 #include <array>
 
+#include "stewart/model/disturbance.h"
 #include "stewart/model/dynamics.h"
-#include "stewart/safety/constraint_set.h"
 #include "stewart/model/linear_algebra6.h"
+#include "stewart/safety/constraint_set.h"
 
 namespace stewart::safety {
 
@@ -32,10 +42,16 @@ struct BarrierEvaluation {
   std::array<double, kMaxVelocityBarriers> w_velocity{};
   std::array<double, kMaxVelocityBarriers> dh_velocity{};  ///< dh_v,i at F_des (m/s^2)
   // Composed (zero when the group is empty).
-  double h_pos = 0.0;               ///< composed position barrier (W)
-  double h_vel = 0.0;               ///< composed velocity barrier (m/s^2)
-  double psi_p = 0.0;               ///< Psi_p(F_des) - position robust margin (W)
-  double psi_v = 0.0;               ///< Psi_v(F_des) - velocity robust margin (m/s^2)
+  double h_pos = 0.0;  ///< composed position barrier (W)
+  double h_vel = 0.0;  ///< composed velocity barrier (m/s^2)
+  double psi_p = 0.0;  ///< Psi_p(F_des) - position robust margin (W)
+  double psi_v = 0.0;  ///< Psi_v(F_des) - velocity robust margin (m/s^2)
+  /// Some axis position barrier has h(q) < 0 and recovery barriers exist: the
+  /// position group's condition is left out (its F gradient vanishes at rest,
+  /// so it would demand unbounded forces) and the recovery barriers steer back.
+  bool outside_position_set = false;
+  /// Some velocity limit or (inside) position limit is exceeded: h < 0.
+  bool outside_safe_set = false;
   Vector6d g_p = Vector6d::Zero();  ///< dPsi_p/dF (W/N = m/s)
   Vector6d g_v = Vector6d::Zero();  ///< dPsi_v/dF (m/s^2 per N)
 };
@@ -52,6 +68,7 @@ struct BarrierIntermediates {
   double s_p = 0.0;            ///< sum_i alpha_i w_i of the position group (1/s)
   Vector6d a_c;                ///< sum_i alpha_i w_i dh_v,i/dqd of the velocity group
   Vector6d m_inv_a_c;          ///< M^-1 a_c (only with velocity barriers)
+  Matrix6d m_inv;              ///< M^-1 (only with velocity barriers)
 };
 
 /// Evaluates every barrier and the two composed conditions at (q, qd, F_des)
@@ -60,11 +77,13 @@ void EvaluateBarriers(const ConstraintSet& constraints, const Vector6d& q, const
                       const DynamicsTerms& terms, const Vector6d& f_des, BarrierEvaluation* out);
 
 /// The same, with the conditions evaluated at the net force the legs push,
-/// F_des + LegViscousFriction(leg_friction_nspm, H^T qd), and the
-/// intermediates returned. Psi is NaN (so the caller rejects the step) when
-/// velocity barriers exist and M is not positive definite.
+/// F_des + LegViscousFriction(leg_friction_nspm, H^T qd), plus the
+/// disturbance estimate, and the intermediates returned. Psi is NaN (so the
+/// caller rejects the step) when velocity barriers exist and M is not
+/// positive definite.
 void EvaluateBarriers(const ConstraintSet& constraints, const Vector6d& q, const Vector6d& qd,
                       const DynamicsTerms& terms, const Vector6d& f_des, double leg_friction_nspm,
-                      BarrierEvaluation* out, BarrierIntermediates* intermediates);
+                      const GeneralizedDisturbance& disturbance, BarrierEvaluation* out,
+                      BarrierIntermediates* intermediates);
 
 }  // namespace stewart::safety

@@ -6,8 +6,13 @@
 //   leg i:   h = sign (l_i - limit),   dh/dq = sign J_l(i,:)   (limit = l_max - margin
 //                                                               or l_min + margin)
 // with sign = -1 for an upper and +1 for a lower limit. Velocity constraints
-// h_v(qd) = sign (qd_j - limit) >= 0 (m/s or rad/s).
+// h_v(qd) = sign (qd_j - limit) >= 0 (m/s or rad/s). Recovery constraints,
+// one per axis position limit (velocity group, docs/safety.md "Outside the
+// safe set"): h_r = sign qd_j + phi(h(q)) >= 0 (m/s) with phi(h) = kappa h
+// inside (h >= 0) and v_r tanh(kappa h / v_r) outside, so the speed back
+// into the set stays below v_r, half the axis's smallest velocity limit.
 #include <array>
+#include <cmath>
 #include <string>
 
 #include "stewart/model/platform_params.h"
@@ -18,7 +23,8 @@ namespace stewart::safety {
 
 /// Capacity: a lower and an upper limit per axis, and per leg.
 constexpr int kMaxPositionBarriers = 2 * kNumAxes + 2 * kNumLegs;
-constexpr int kMaxVelocityBarriers = 2 * kNumAxes;
+/// Velocity limits and the recovery barriers of the axis position limits.
+constexpr int kMaxVelocityBarriers = 4 * kNumAxes;
 
 enum class PositionSource { kAxis, kLegLength };
 
@@ -35,10 +41,19 @@ struct PositionBarrierSpec {
 struct VelocityBarrierSpec {
   int axis = 0;
   double sign = -1.0;
-  double limit = 0.0;    ///< m/s or rad/s
+  double limit = 0.0;    ///< m/s or rad/s (unused by a recovery barrier)
   double alpha_v = 1.0;  ///< class-K gain (1/s)
-  std::string name;      ///< e.g. "zd_upper"
+  std::string name;      ///< e.g. "zd_upper", "z_upper_recovery"
+  /// A recovery barrier: the index of its axis position barrier, whose
+  /// h(q) = sign (q_j - limit) it reads; -1 for a velocity limit.
+  int recovery_of = -1;
+  double recovery_gain_per_s = 0.0;  ///< kappa (1/s)
+  /// v_r (m/s or rad/s); 0: the axis has no velocity limit, phi stays linear.
+  double recovery_speed = 0.0;
 };
+
+/// phi(h) of a recovery barrier and its derivative dphi/dh.
+inline void RecoveryTarget(const VelocityBarrierSpec& s, double h, double* phi, double* dphi_dh);
 
 struct ConstraintSet {
   int num_position = 0;
@@ -50,7 +65,23 @@ struct ConstraintSet {
   /// Subtracted from psi_p (W) and psi_v (m/s^2): robustness margins.
   double position_margin = 0.0;
   double velocity_margin = 0.0;
+  /// k_sigma: every barrier derivative is taken at the worst disturbance
+  /// within this many standard deviations of the estimate (barriers.h).
+  double disturbance_sigma = 0.0;
+  bool has_recovery = false;  ///< recovery barriers are in the velocity group
 };
+
+inline void RecoveryTarget(const VelocityBarrierSpec& s, double h, double* phi, double* dphi_dh) {
+  const double kappa = s.recovery_gain_per_s;
+  if (h >= 0.0 || !(s.recovery_speed > 0.0)) {
+    *phi = kappa * h;
+    *dphi_dh = kappa;
+    return;
+  }
+  const double t = std::tanh(kappa * h / s.recovery_speed);
+  *phi = s.recovery_speed * t;
+  *dphi_dh = kappa * (1.0 - t * t);
+}
 
 /// Throws InputError (a std::invalid_argument naming the config key) when the
 /// config holds more constraints than the capacity (an axis listed twice) or

@@ -17,6 +17,9 @@ enum FilterFlag : std::int32_t {
   kFlagFallback = 4,       ///< the safe stop (last resort) was applied
   kFlagInvalidInput = 16,  ///< non-finite or out-of-range q, qd or F_des
   kFlagForceLimited = 64,  ///< an actuator force limit is active at F*
+  /// A limit is exceeded (some h < 0): the filter steers back into the safe
+  /// set (docs/safety.md, "Outside the safe set").
+  kFlagOutsideSafeSet = 128,
 };
 
 struct SafetyDiagnostics {

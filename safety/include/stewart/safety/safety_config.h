@@ -83,6 +83,17 @@ struct SafetyConfig {
   double velocity_robust_margin_mps2 = 0.0;
   double position_robust_margin_w = 0.0;
   double leg_friction_nspm = 0.0;
+  /// Optional key: kappa of the recovery barriers h_r = sign qd_j + kappa h(q)
+  /// of the axis position limits (1/s; docs/safety.md "Outside the safe
+  /// set"); 0 leaves them out. Default 20: inactive more than
+  /// (velocity limit) / kappa, under 1 mm, inside a position limit.
+  double recovery_gain_per_s = 20.0;
+  /// Optional keys: use the state's disturbance estimate d (model/disturbance.h)
+  /// in every barrier derivative, and take each derivative at the worst d
+  /// within disturbance_sigma standard deviations of it (docs/safety.md,
+  /// "Model error").
+  bool use_disturbance_estimate = true;
+  double disturbance_sigma = 3.0;
 };
 
 inline std::string ToString(SafetyVariant variant) {

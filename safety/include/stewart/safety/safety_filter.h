@@ -39,12 +39,20 @@ class SafetyFilter {
   /// is the wall time of this whole call (model terms included).
   Vector6d Step(const Vector6d& q, const Vector6d& qd, const Vector6d& f_des,
                 SafetyDiagnostics* diagnostics);
+  /// The same with the state's estimate of the model error d (barriers.h);
+  /// ignored when safety.use_disturbance_estimate is false. A non-finite or
+  /// negative-std estimate is invalid input (the safe stop, flagged).
+  Vector6d Step(const Vector6d& q, const Vector6d& qd, const Vector6d& f_des,
+                const GeneralizedDisturbance& disturbance, SafetyDiagnostics* diagnostics);
 
   /// The filter given the model terms at (q, qd) (from EvaluateDynamics).
   /// Not timed: diagnostics->compute_ns is set to 0 (Step times the step,
   /// and a clock read is not negligible against this call: docs/performance.md).
   Vector6d StepWithTerms(const DynamicsTerms& terms, const Vector6d& q, const Vector6d& qd,
                          const Vector6d& f_des, SafetyDiagnostics* diagnostics) const;
+  Vector6d StepWithTerms(const DynamicsTerms& terms, const Vector6d& q, const Vector6d& qd,
+                         const Vector6d& f_des, const GeneralizedDisturbance& disturbance,
+                         SafetyDiagnostics* diagnostics) const;
 
   /// The configured safe stop at (q, qd), for when no usable nominal command
   /// exists (stale or missing): flagged kFlagFallback, case kFallback. Zero
@@ -148,6 +156,7 @@ class SafetyFilter {
   double force_limit_n_;
   SafetyFallback fallback_;
   double stop_time_s_;
+  bool use_disturbance_;
   ReferenceQpSolver* reference_;
   /// The data of the step under way (filter_workspace.h): written by every
   /// step before it is read, so a const step changes nothing observable.
