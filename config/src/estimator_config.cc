@@ -26,11 +26,29 @@ EstimatorConfig ParseEstimatorConfig(const ConfigNode& estimator) {
       estimator.IntInRange("divergence_rejections", 1, INT_MAX, "must be >= 1");
   e.max_dt_s = estimator.PositiveDouble("max_dt_s");
   e.command_timeout_s = estimator.PositiveDouble("command_timeout_s");
+  if (estimator.Has("command_latency_s")) {
+    e.command_latency_s = estimator.NonNegativeDouble("command_latency_s");
+  }
   e.settle_samples = estimator.IntInRange("settle_samples", 0, INT_MAX, "must not be negative");
   e.max_gyro_radps = estimator.PositiveDouble("max_gyro_radps");
   e.max_accel_mps2 = estimator.PositiveDouble("max_accel_mps2");
   e.leg_range_margin_m = estimator.NonNegativeDouble("leg_range_margin_m");
   e.perfect_state = estimator.Bool("perfect_state");
+  if (estimator.Has("disturbance")) {
+    const ConfigNode d = estimator.Child("disturbance");
+    e.estimate_disturbance = d.Bool("enabled");
+    e.disturbance_walk_n_per_sqrt_s = d.PositiveDouble("walk_n_per_sqrt_s");
+    e.disturbance_walk_nm_per_sqrt_s = d.PositiveDouble("walk_nm_per_sqrt_s");
+    e.initial_disturbance_std_n = d.PositiveDouble("initial_std_n");
+    e.initial_disturbance_std_nm = d.PositiveDouble("initial_std_nm");
+    e.disturbance_jump_std_n = d.NonNegativeDouble("jump_std_n");
+    e.disturbance_jump_std_nm = d.NonNegativeDouble("jump_std_nm");
+    e.disturbance_jump_after_samples =
+        d.IntInRange("jump_after_samples", 1, INT_MAX, "must be >= 1");
+    if (e.estimate_disturbance && e.process_model != EstimatorProcessModel::kDynamics) {
+      d.Fail("enabled", "needs estimator.process_model: dynamics (d acts through the dynamics)");
+    }
+  }
   return e;
 }
 

@@ -73,6 +73,12 @@ SafetyConfig ParseSafetyConfig(const ConfigNode& safety) {
     s.position_robust_margin_w = safety.NonNegativeDouble("position_robust_margin_w");
   }
   if (safety.Has("model_leg_friction")) s.model_leg_friction = safety.Bool("model_leg_friction");
+  if (safety.Has("position_rate_per_s")) {
+    s.position_rate_per_s = safety.PositiveDouble("position_rate_per_s");
+  }
+  if (safety.Has("velocity_rate_per_s")) {
+    s.velocity_rate_per_s = safety.PositiveDouble("velocity_rate_per_s");
+  }
   if (safety.Has("recovery_gain_per_s")) {
     s.recovery_gain_per_s = safety.NonNegativeDouble("recovery_gain_per_s");
   }

@@ -11,9 +11,15 @@ Vector6d PdAcceleration(const ControllerConfig& gains, const Vector6d& q, const 
 Vector6d NominalForce(const PlatformParams& platform, const ControllerConfig& gains,
                       const Vector6d& q, const Vector6d& qd, const Setpoint& setpoint,
                       DynamicsTerms* terms) {
+  return NominalForce(platform, gains, q, qd, Vector6d::Zero(), setpoint, terms);
+}
+
+Vector6d NominalForce(const PlatformParams& platform, const ControllerConfig& gains,
+                      const Vector6d& q, const Vector6d& qd, const Vector6d& disturbance_n,
+                      const Setpoint& setpoint, DynamicsTerms* terms) {
   EvaluateDynamics(platform, q, qd, terms);
   // The legs lose LegViscousFriction on the way: command it on top.
-  return InverseDynamics(*terms, PdAcceleration(gains, q, qd, setpoint)) -
+  return InverseDynamics(*terms, PdAcceleration(gains, q, qd, setpoint), disturbance_n) -
          LegViscousFriction(gains.leg_friction_nspm, terms->H.transpose() * qd);
 }
 

@@ -27,7 +27,14 @@ SetpointStatus Controller::OfferSetpoint(const Setpoint& setpoint) {
 
 StepStatus Controller::Step(int64_t utime, const Vector6d& q, const Vector6d& qd,
                             ControllerOutput* out) {
-  if (!q.allFinite() || !qd.allFinite()) return StepStatus::kNonFiniteState;
+  return Step(utime, q, qd, Vector6d::Zero(), out);
+}
+
+StepStatus Controller::Step(int64_t utime, const Vector6d& q, const Vector6d& qd,
+                            const Vector6d& disturbance_n, ControllerOutput* out) {
+  if (!q.allFinite() || !qd.allFinite() || !disturbance_n.allFinite()) {
+    return StepStatus::kNonFiniteState;
+  }
   if (last_utime_ && utime <= *last_utime_) return StepStatus::kTimeNotIncreasing;
   last_utime_ = utime;
   if (!first_utime_) first_utime_ = utime;
@@ -46,7 +53,9 @@ StepStatus Controller::Step(int64_t utime, const Vector6d& q, const Vector6d& qd
     if (t_s >= scenario_->duration_s()) scenario_finished_ = true;
   }
 
-  const Vector6d force_n = NominalForce(platform_, gains_, q, qd, active_, &terms_);
+  const Vector6d force_n = NominalForce(
+      platform_, gains_, q, qd, gains_.compensate_disturbance ? disturbance_n : Vector6d::Zero(),
+      active_, &terms_);
   if (!force_n.allFinite()) return StepStatus::kNonFiniteForce;
   out->force_n = force_n;
   out->setpoint = active_;

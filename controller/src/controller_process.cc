@@ -28,7 +28,8 @@ ControllerVerdict ControllerProcess::OnState(const StateSample& state,
     return ControllerVerdict::kStateNotUsable;
   }
   ControllerOutput step;
-  const StepStatus status = controller_.Step(state.utime, state.q, state.qd, &step);
+  const StepStatus status =
+      controller_.Step(state.utime, state.q, state.qd, state.disturbance, &step);
   if (status != StepStatus::kOk) {
     counters_->Reject(ToString(status));
     return ControllerVerdict::kStepRejected;

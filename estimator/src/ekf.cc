@@ -82,30 +82,32 @@ EulerAngleTrig ShiftEulerAngleTrig(const EulerAngleTrig& from, const Vector3d& d
 }
 
 // P -= G G^T on the lower block triangle (blocks of rows and columns [0, 6),
-// [6, 12), [12, 16): whole SIMD packets), the upper blocks as the mirror.
-// Inside a diagonal block an entry and its mirror are the same sum of the
-// same products in the same order, so P stays symmetric to the last bit.
+// [6, 12), [12, 18), [18, 22): whole SIMD packets), the upper blocks as the
+// mirror. Inside a diagonal block an entry and its mirror are the same sum of
+// the same products in the same order, so P stays symmetric to the last bit.
+template <int Start, int End, int M>
+void SubtractGramBlock(const Eigen::Matrix<double, kEkfStateSize + 1, M>& g,
+                       Eigen::Matrix<double, kEkfStateSize + 1, kEkfStateSize + 1>* p) {
+  constexpr int kRows = kEkfStateSize + 1 - Start;
+  for (int j = Start; j < End; ++j) {
+    Eigen::Matrix<double, kRows, 1> col = p->col(j).template tail<kRows>();
+    for (int k = 0; k < M; ++k) col -= g(j, k) * g.col(k).template tail<kRows>();
+    p->col(j).template tail<kRows>() = col;
+  }
+}
+
 template <int M>
 void SubtractGram(const Eigen::Matrix<double, kEkfStateSize + 1, M>& g,
                   Eigen::Matrix<double, kEkfStateSize + 1, kEkfStateSize + 1>* p) {
-  constexpr int kN = kEkfStateSize + 1;
-  for (int j = 0; j < 6; ++j) {
-    Eigen::Matrix<double, kN, 1> col = p->col(j);
-    for (int k = 0; k < M; ++k) col -= g(j, k) * g.col(k);
-    p->col(j) = col;
-  }
-  for (int j = 6; j < 12; ++j) {
-    Eigen::Matrix<double, kN - 6, 1> col = p->col(j).template tail<kN - 6>();
-    for (int k = 0; k < M; ++k) col -= g(j, k) * g.col(k).template tail<kN - 6>();
-    p->col(j).template tail<kN - 6>() = col;
-  }
-  for (int j = 12; j < kEkfStateSize; ++j) {
-    Eigen::Matrix<double, kN - 12, 1> col = p->col(j).template tail<kN - 12>();
-    for (int k = 0; k < M; ++k) col -= g(j, k) * g.col(k).template tail<kN - 12>();
-    p->col(j).template tail<kN - 12>() = col;
-  }
-  p->template block<6, 10>(0, 6) = p->template block<10, 6>(6, 0).transpose();
-  p->template block<6, 4>(6, 12) = p->template block<4, 6>(12, 6).transpose();
+  static_assert(kEkfQd == 6 && kEkfDisturbance == 12 && kEkfGyroBias == 18,
+                "the blocks below follow the state layout");
+  SubtractGramBlock<0, 6>(g, p);
+  SubtractGramBlock<6, 12>(g, p);
+  SubtractGramBlock<12, 18>(g, p);
+  SubtractGramBlock<18, kEkfStateSize>(g, p);
+  p->template block<6, 16>(0, 6) = p->template block<16, 6>(6, 0).transpose();
+  p->template block<6, 10>(6, 12) = p->template block<10, 6>(12, 6).transpose();
+  p->template block<6, 4>(12, 18) = p->template block<4, 6>(18, 12).transpose();
 }
 
 }  // namespace
@@ -132,9 +134,24 @@ Ekf::Ekf(const PlatformParams& params, const ActuatorConfig& actuators, const Se
 
 void Ekf::SetForceCommand(int64_t utime, const Vector6d& force_n) {
   if (!force_n.allFinite()) return;  // the node counts it; never feed NaN into the model
-  has_command_ = true;
-  command_utime_ = utime;
-  command_n_ = force_n.cwiseMax(-actuators_.force_limit_n).cwiseMin(actuators_.force_limit_n);
+  TimedCommand& slot = command_history_[static_cast<size_t>(command_next_)];
+  slot.utime = utime;
+  slot.force_n = force_n.cwiseMax(-actuators_.force_limit_n).cwiseMin(actuators_.force_limit_n);
+  command_next_ = (command_next_ + 1) % kCommandHistory;
+  command_count_ = std::min(command_count_ + 1, kCommandHistory);
+}
+
+const Ekf::TimedCommand* Ekf::ActingCommand(int64_t interval_start_utime) const {
+  // The newest command issued at least the latency before the interval
+  // starts; without a latency, the newest command.
+  const int64_t latest_utime =
+      interval_start_utime - static_cast<int64_t>(config_.command_latency_s / kUsToS);
+  for (int k = 0; k < command_count_; ++k) {
+    const TimedCommand& c = command_history_[static_cast<size_t>(
+        (command_next_ - 1 - k + kCommandHistory) % kCommandHistory)];
+    if (config_.command_latency_s <= 0.0 || c.utime <= latest_utime) return &c;
+  }
+  return nullptr;
 }
 
 void Ekf::Reset() {
@@ -143,19 +160,24 @@ void Ekf::Reset() {
   P_ = PaddedIdentity();
   qdd_.setZero();
   consecutive_leg_rejections_ = 0;
+  consecutive_accel_gated_ = 0;
   samples_since_init_ = 0;
 }
 
 void Ekf::Initialize(int64_t utime, const Vector6d& q, const Vector6d& qd, const EkfVector& std) {
   x_.segment<6>(kEkfQ) = q;
   x_.segment<6>(kEkfQd) = qd;
+  x_.segment<6>(kEkfDisturbance).setZero();
   x_.segment<3>(kEkfGyroBias).setZero();
   P_.setZero();
   P_.diagonal().head<kEkfStateSize>() = std.cwiseProduct(std);
+  // Without disturbance estimation d is held at zero, with zero covariance.
+  if (!config_.estimate_disturbance) P_.diagonal().segment<6>(kEkfDisturbance).setZero();
   qdd_.setZero();
   last_utime_ = utime;
   initialized_ = true;
   consecutive_leg_rejections_ = 0;
+  consecutive_accel_gated_ = 0;
   samples_since_init_ = 0;
 }
 
@@ -190,7 +212,19 @@ bool Ekf::InitializeFromLegs(const SensorSample& sample, uint32_t* events) {
   std.segment<3>(kEkfQd).setConstant(config_.initial_velocity_std_mps);
   std.segment<3>(kEkfQd + 3).setConstant(config_.initial_angular_rate_std_radps);
   std.segment<3>(kEkfGyroBias).setConstant(config_.initial_gyro_bias_std_radps);
+  std.segment<3>(kEkfDisturbance).setConstant(config_.initial_disturbance_std_n);
+  std.segment<3>(kEkfDisturbance + 3).setConstant(config_.initial_disturbance_std_nm);
+  // A restart keeps what was learnt of d (a payload does not go away when
+  // the estimate is restarted), with its initial uncertainty.
+  const Vector6d d_before = x_.segment<6>(kEkfDisturbance);
+  // ... unless the restart is the arithmetic's breakdown (a d far beyond any
+  // step the config allows for is that).
+  const bool keep_d =
+      initialized_ &&
+      (d_before.head<3>().array().abs() <= 10.0 * config_.disturbance_jump_std_n).all() &&
+      (d_before.tail<3>().array().abs() <= 10.0 * config_.disturbance_jump_std_nm).all();
   Initialize(sample.utime, fk.q, Vector6d::Zero(), std);
+  if (keep_d && config_.estimate_disturbance) x_.segment<6>(kEkfDisturbance) = d_before;
   *events |= kEventInitialized;
   return true;
 }
@@ -198,16 +232,18 @@ bool Ekf::InitializeFromLegs(const SensorSample& sample, uint32_t* events) {
 void Ekf::Predict(double dt_s, int64_t utime, const EulerAngleTrig& trig, uint32_t* events) {
   const Vector6d q = x_.segment<6>(kEkfQ);
   const Vector6d qd = x_.segment<6>(kEkfQd);
+  const TimedCommand* command = ActingCommand(last_utime_);
   const bool command_fresh =
-      has_command_ &&
-      utime - command_utime_ <= static_cast<int64_t>(config_.command_timeout_s / kUsToS);
+      command != nullptr &&
+      utime - command->utime <= static_cast<int64_t>(config_.command_timeout_s / kUsToS);
   const bool use_dynamics =
       config_.process_model == EstimatorProcessModel::kDynamics && command_fresh;
   double sigma_lin = config_.process_accel_std_mps2;
   double sigma_ang = config_.process_angaccel_std_radps2;
   if (use_dynamics) {
     DynamicsAccelerationJacobians(params_, actuators_.viscous_friction_nspm, q, trig, qd,
-                                  command_n_, &qdd_, &dqdd_dq_, &dqdd_dqd_);
+                                  command->force_n, x_.segment<6>(kEkfDisturbance), &qdd_,
+                                  &dqdd_dq_, &dqdd_dqd_, &m_inv_);
     sigma_lin = config_.dynamics_accel_std_mps2;
     sigma_ang = config_.dynamics_angaccel_std_radps2;
   } else {
@@ -218,28 +254,30 @@ void Ekf::Predict(double dt_s, int64_t utime, const EulerAngleTrig& trig, uint32
   x_.segment<6>(kEkfQ) += dt_s * qd + 0.5 * dt_s * dt_s * qdd_;
   x_.segment<6>(kEkfQd) += dt_s * qdd_;
 
-  // P <- Phi P Phi^T with the transition of [q; qd] to first order in dt,
-  //   Phi = [[I, dt I], [0, I]] + [[0, 0], [W]],  W = dt [A, B]
-  // (A = dqdd/dq, B = dqdd/dqd; W = 0 for the constant-velocity model), and
-  // the identity on the gyro bias, in place: first T = Phi P (rows), then
-  // T Phi^T (columns). With U = W P_[(q,qd), :] (6x16):
-  //   T_q = P_q + dt P_v,  T_v = P_v + U            (rows)
-  //   P'_:q = T_:q + dt T_:v                         (columns)
-  //   P'_vv = T_vv + T_v,(q,qd) W^T,  P'_bv = P_bv + U_b^T
+  // P <- Phi P Phi^T with the transition of [q; qd; d] to first order in dt,
+  //   Phi = [[I, dt I, 0], [0, I, 0], [0, 0, I]] + [[0, 0, 0], [W], [0, 0, 0]],
+  //   W = dt [A, B, M^-1]
+  // (A = dqdd/dq, B = dqdd/dqd, M^-1 = dqdd/dd; W = 0 for the
+  // constant-velocity model), and the identity on d and the gyro bias, in
+  // place: first T = Phi P (rows), then T Phi^T (columns). With
+  // U = W P_[(q,qd,d), :] (6x22):
+  //   T_q = P_q + dt P_v,  T_v = P_v + U                  (rows)
+  //   P'_:q = T_:q + dt T_:v                               (columns)
+  //   P'_vv = T_vv + T_v,(q,qd,d) W^T,  P'_(d,b)v = P_(d,b)v + U_(d,b)^T
   // and the upper blocks as the mirror of the lower ones.
   const auto rows_v = P_.middleRows<6>(kEkfQd);
   if (use_dynamics) {
-    Eigen::Matrix<double, 6, 12> w;
-    w << dt_s * dqdd_dq_, dt_s * dqdd_dqd_;
+    Eigen::Matrix<double, 6, 18> w;
+    w << dt_s * dqdd_dq_, dt_s * dqdd_dqd_, dt_s * m_inv_;
     Eigen::Matrix<double, 6, kEkfStateSize + 1> u;
-    u.noalias() = w.lazyProduct(P_.topRows<12>());
+    u.noalias() = w.lazyProduct(P_.topRows<18>());
     P_.middleRows<6>(kEkfQ) += dt_s * rows_v;
     P_.middleRows<6>(kEkfQd) += u;
     Matrix6d z;
-    z.noalias() = P_.block<6, 12>(kEkfQd, 0).lazyProduct(w.transpose());
+    z.noalias() = P_.block<6, 18>(kEkfQd, 0).lazyProduct(w.transpose());
     P_.leftCols<6>() += dt_s * P_.middleCols<6>(kEkfQd);
     P_.block<6, 6>(kEkfQd, kEkfQd) += z;
-    P_.block<4, 6>(kEkfGyroBias, kEkfQd) += u.rightCols<4>().transpose();
+    P_.block<10, 6>(kEkfDisturbance, kEkfQd) += u.rightCols<10>().transpose();
   } else {
     P_.middleRows<6>(kEkfQ) += dt_s * rows_v;
     P_.leftCols<6>() += dt_s * P_.middleCols<6>(kEkfQd);
@@ -254,6 +292,12 @@ void Ekf::Predict(double dt_s, int64_t utime, const EulerAngleTrig& trig, uint32
   }
   const double walk = config_.gyro_bias_walk_radps_per_sqrt_s;
   P_.diagonal().segment<3>(kEkfGyroBias).array() += walk * walk * dt_s;
+  if (config_.estimate_disturbance) {
+    const double walk_n = config_.disturbance_walk_n_per_sqrt_s;
+    const double walk_nm = config_.disturbance_walk_nm_per_sqrt_s;
+    P_.diagonal().segment<3>(kEkfDisturbance).array() += walk_n * walk_n * dt_s;
+    P_.diagonal().segment<3>(kEkfDisturbance + 3).array() += walk_nm * walk_nm * dt_s;
+  }
 }
 
 template <int M, int NB>
@@ -345,10 +389,43 @@ void Ekf::CorrectAccel(const Vector3d& accel_mps2, const EulerAngleTrig& trig, u
     const Eigen::Matrix<double, 12, 3> pt = P_.topLeftCorner<12, 12>().lazyProduct(t);
     R.noalias() += t.transpose() * pt;
   }
-  Eigen::Matrix<double, 3, 6> h;
-  h << j.d_angles, j.d_rates;
   double nis = 0.0;
-  if (!Correct<3, 2>(accel_mps2 - predicted, {kEkfQ + 3, kEkfQd + 3}, h, R, &nis)) {
+  const Vector3d y = accel_mps2 - predicted;
+  if (!(config_.estimate_disturbance && qdd_from_dynamics_)) {
+    Eigen::Matrix<double, 3, 6> h;
+    h << j.d_angles, j.d_rates;
+    if (!Correct<3, 2>(y, {kEkfQ + 3, kEkfQd + 3}, h, R, &nis)) *events |= kGateAccel;
+    return;
+  }
+  // The specific force sees qdd, and qdd sees d through M^-1: the
+  // accelerometer is what makes d observable within a few samples.
+  Eigen::Matrix<double, 3, 12> h;
+  h << j.d_angles, j.d_rates, j.d_qdd * m_inv_;
+  const std::array<int, 4> blocks = {kEkfQ + 3, kEkfQd + 3, kEkfDisturbance, kEkfDisturbance + 3};
+  if (Correct<3, 4>(y, blocks, h, R, &nis)) {
+    consecutive_accel_gated_ = 0;
+    return;
+  }
+  // Beyond the gate for long enough to be a step in d (a push, a payload set
+  // down) that the random walk cannot follow, not the transient of a command
+  // the actuators apply later than the model assumes: re-open d's
+  // uncertainty and use the sample.
+  if (++consecutive_accel_gated_ < config_.disturbance_jump_after_samples) {
+    *events |= kGateAccel;
+    return;
+  }
+  consecutive_accel_gated_ = 0;
+  const double jump_n = config_.disturbance_jump_std_n;
+  const double jump_nm = config_.disturbance_jump_std_nm;
+  // Raised to the jump's variance, not by it: repeated jumps (a run of bad
+  // samples) must not grow d's uncertainty without bound.
+  P_.diagonal().segment<3>(kEkfDisturbance) =
+      P_.diagonal().segment<3>(kEkfDisturbance).cwiseMax(jump_n * jump_n);
+  P_.diagonal().segment<3>(kEkfDisturbance + 3) =
+      P_.diagonal().segment<3>(kEkfDisturbance + 3).cwiseMax(jump_nm * jump_nm);
+  if (Correct<3, 4>(y, blocks, h, R, &nis)) {
+    *events |= kEventDisturbanceJump;
+  } else {
     *events |= kGateAccel;
   }
 }
@@ -461,6 +538,8 @@ Estimate Ekf::estimate() const {
   e.q_std = P_.diagonal().segment<6>(kEkfQ).cwiseMax(0.0).cwiseSqrt();
   e.qd_std = P_.diagonal().segment<6>(kEkfQd).cwiseMax(0.0).cwiseSqrt();
   e.gyro_bias_radps = x_.segment<3>(kEkfGyroBias);
+  e.disturbance_n = x_.segment<6>(kEkfDisturbance);
+  e.disturbance_std_n = P_.diagonal().segment<6>(kEkfDisturbance).cwiseMax(0.0).cwiseSqrt();
   e.initializing = samples_since_init_ < config_.settle_samples;
   e.diverged = diverged_ && e.initializing;
   return e;

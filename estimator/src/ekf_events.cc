@@ -34,6 +34,8 @@ const char* EkfEventName(EkfEvent event) {
       return "gated_orientation";
     case kRejectInitFailed:
       return "init_fk_failed";
+    case kEventDisturbanceJump:
+      return "disturbance_jumps";
   }
   return "unknown";
 }

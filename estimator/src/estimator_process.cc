@@ -12,8 +12,9 @@ StateSample StateFromEstimate(const Estimate& estimate, int64_t seq) {
   StateSample s;
   s.utime = s.sample_utime = estimate.utime;
   s.seq = seq;
-  std::tie(s.q, s.qd, s.q_std, s.qd_std) =
-      std::tie(estimate.q, estimate.qd, estimate.q_std, estimate.qd_std);
+  std::tie(s.q, s.qd, s.q_std, s.qd_std, s.disturbance, s.disturbance_std) =
+      std::tie(estimate.q, estimate.qd, estimate.q_std, estimate.qd_std, estimate.disturbance_n,
+               estimate.disturbance_std_n);
   s.status = estimate.initializing ? kStateInitializing : kStateValid;
   if (estimate.diverged) s.status |= kStateDiverged;
   return s;
@@ -75,7 +76,8 @@ bool EstimatorProcess::OnTruth(const StateSample& truth, StateSample* out) {
 
 bool EstimatorProcess::Emit(const StateSample& state, StateSample* out) {
   if (!state.q.allFinite() || !state.qd.allFinite() || !state.q_std.allFinite() ||
-      !state.qd_std.allFinite()) {
+      !state.qd_std.allFinite() || !state.disturbance.allFinite() ||
+      !state.disturbance_std.allFinite()) {
     counters_->Reject("estimate_non_finite");
     return false;
   }

@@ -70,6 +70,16 @@ void DynamicsAccelerationJacobians(const PlatformParams& params, double friction
                                    const Vector6d& q, const EulerAngleTrig& trig,
                                    const Vector6d& qd, const Vector6d& force_n, Vector6d* qdd,
                                    Matrix6d* dqdd_dq, Matrix6d* dqdd_dqd) {
+  Matrix6d m_inv;
+  DynamicsAccelerationJacobians(params, friction_nspm, q, trig, qd, force_n, Vector6d::Zero(), qdd,
+                                dqdd_dq, dqdd_dqd, &m_inv);
+}
+
+void DynamicsAccelerationJacobians(const PlatformParams& params, double friction_nspm,
+                                   const Vector6d& q, const EulerAngleTrig& trig,
+                                   const Vector6d& qd, const Vector6d& force_n,
+                                   const Vector6d& disturbance_n, Vector6d* qdd, Matrix6d* dqdd_dq,
+                                   Matrix6d* dqdd_dqd, Matrix6d* m_inv) {
   DynamicsTerms terms;
   EvaluateDynamics(params, q, qd, &terms);
   const Matrix6d& H = terms.H;
@@ -175,15 +185,18 @@ void DynamicsAccelerationJacobians(const PlatformParams& params, double friction
     qdd->setConstant(NAN);
     dqdd_dq->setConstant(NAN);
     dqdd_dqd->setConstant(NAN);
+    m_inv->setConstant(NAN);
     return;
   }
-  *qdd = inertia.Solve<1>(H * force - terms.C_qd - terms.G);
-  Rhs6<12> rhs;
+  *qdd = inertia.Solve<1>(H * force + disturbance_n - terms.C_qd - terms.G);
+  Rhs6<18> rhs;
   rhs.leftCols<6>() = numerator;
-  rhs.rightCols<6>().noalias() = -friction_nspm * H.lazyProduct(H.transpose());
-  inertia.SolveInPlace<12>(&rhs);
+  rhs.middleCols<6>(6).noalias() = -friction_nspm * H.lazyProduct(H.transpose());
+  rhs.rightCols<6>().setIdentity();
+  inertia.SolveInPlace<18>(&rhs);
   *dqdd_dq = rhs.leftCols<6>();
-  *dqdd_dqd = rhs.rightCols<6>();
+  *dqdd_dqd = rhs.middleCols<6>(6);
+  *m_inv = rhs.rightCols<6>();
 }
 
 }  // namespace stewart

@@ -183,7 +183,12 @@ Vector6d GeneralisedForceOfWrench(const Vector6d& q, const Vector6d& wrench_in_B
 }
 
 Vector6d InverseDynamics(const DynamicsTerms& terms, const Vector6d& qdd) {
-  Vector6d force_n = terms.M * qdd + terms.C_qd + terms.G;
+  return InverseDynamics(terms, qdd, Vector6d::Zero());
+}
+
+Vector6d InverseDynamics(const DynamicsTerms& terms, const Vector6d& qdd,
+                         const Vector6d& external_generalised_force) {
+  Vector6d force_n = terms.M * qdd + terms.C_qd + terms.G - external_generalised_force;
   if (!SolvePartialPivot6(terms.H, &force_n)) return Vector6d::Constant(NAN);
   return force_n;
 }

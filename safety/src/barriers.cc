@@ -64,7 +64,7 @@ void EvaluateBarriers(const ConstraintSet& c, const Vector6d& q, const Vector6d&
     e.h_pos = ComposeLogSumExp(e.alpha_h_position.data(), c.num_position, c.k_position,
                                e.w_position.data());
     double sum_alpha_w = 0.0;
-    double psi = e.h_pos;
+    double psi = c.position_rate_per_s * e.h_pos;
     for (int i = 0; i < c.num_position; ++i) {
       const size_t k = static_cast<size_t>(i);
       const double alpha_w = c.position[k].alpha * e.w_position[k];
@@ -122,7 +122,7 @@ void EvaluateBarriers(const ConstraintSet& c, const Vector6d& q, const Vector6d&
     // dh_v,i/dd = sign_i (M^-1)_(axis, :): the worst case per axis.
     Vector6d axis_bound = Vector6d::Zero();
     if (robust) axis_bound.noalias() = x->m_inv.cwiseAbs() * d_bound;
-    double psi = e.h_vel;
+    double psi = c.velocity_rate_per_s * e.h_vel;
     for (int i = 0; i < c.num_velocity; ++i) {
       const size_t k = static_cast<size_t>(i);
       const VelocityBarrierSpec& s = c.velocity[k];

@@ -17,6 +17,12 @@ ConstraintSet BuildConstraintSet(const PlatformParams& platform, const SafetyCon
   STEWART_CHECK_INPUT(safety.velocity_robust_margin_mps2 >= 0.0,
                       "safety.velocity_robust_margin_mps2", "must be >= 0");
   c.position_margin = safety.position_robust_margin_w;
+  STEWART_CHECK_INPUT(safety.position_rate_per_s > 0.0, "safety.position_rate_per_s",
+                      "must be positive");
+  STEWART_CHECK_INPUT(safety.velocity_rate_per_s > 0.0, "safety.velocity_rate_per_s",
+                      "must be positive");
+  c.position_rate_per_s = safety.position_rate_per_s;
+  c.velocity_rate_per_s = safety.velocity_rate_per_s;
   c.velocity_margin = safety.velocity_robust_margin_mps2;
   auto add_position = [&](PositionSource source, int index, double sign, double limit,
                           double alpha_e, double alpha, const std::string& name) {

@@ -51,6 +51,8 @@ bool AccelerationMetricMap(const Matrix6d& h, const Cholesky6& inertia, Matrix6d
   return false;
 }
 
+const Vector6d kNoDisturbance = Vector6d::Zero();
+
 FilterCase CaseFromMultipliers(double mu_p, double mu_v) {
   if (mu_p > 0.0 && mu_v > 0.0) return FilterCase::kBoth;
   if (mu_p > 0.0) return FilterCase::kPosition;
@@ -140,7 +142,9 @@ Vector6d SafetyFilter::StepWithTerms(const DynamicsTerms& terms, const Vector6d&
       state_valid && disturbance_valid && (f_des.array().abs() <= kMaxInputForceN).all();
   bool ok = input_valid;
   FilterWorkspace& ws = workspace_;
-  const StepInput in{terms, qd, f_des, d->barriers};
+  const Vector6d& held_disturbance =
+      use_disturbance_ && disturbance_valid ? disturbance.force_n : kNoDisturbance;
+  const StepInput in{terms, qd, f_des, d->barriers, held_disturbance};
   if (ok) {
     EvaluateBarriers(constraints_, q, qd, terms, f_des, leg_friction_nspm_,
                      use_disturbance_ ? disturbance : GeneralizedDisturbance{}, &d->barriers,
@@ -175,7 +179,7 @@ Vector6d SafetyFilter::StepWithTerms(const DynamicsTerms& terms, const Vector6d&
     d->filter_case = FilterCase::kFallback;
     d->flags |= kFlagFallback | (input_valid ? kFlagInfeasible : kFlagInvalidInput);
     d->infeasible = input_valid;
-    d->f_safe = SafeStop(terms, qd, state_valid);
+    d->f_safe = SafeStop(terms, qd, state_valid, held_disturbance);
   }
   if (d->barriers.outside_safe_set) d->flags |= kFlagOutsideSafeSet;
   const Vector6d correction = d->f_safe - f_des;
@@ -187,6 +191,12 @@ Vector6d SafetyFilter::StepWithTerms(const DynamicsTerms& terms, const Vector6d&
 
 Vector6d SafetyFilter::SafeStopCommand(const Vector6d& q, const Vector6d& qd,
                                        SafetyDiagnostics* d) {
+  return SafeStopCommand(q, qd, GeneralizedDisturbance{}, d);
+}
+
+Vector6d SafetyFilter::SafeStopCommand(const Vector6d& q, const Vector6d& qd,
+                                       const GeneralizedDisturbance& disturbance,
+                                       SafetyDiagnostics* d) {
   *d = SafetyDiagnostics{};
   d->variant = variant_;
   DynamicsTerms& terms = workspace_.terms;
@@ -194,16 +204,19 @@ Vector6d SafetyFilter::SafeStopCommand(const Vector6d& q, const Vector6d& qd,
   if (state_valid) EvaluateDynamics(platform_, q, qd, &terms);
   d->filter_case = FilterCase::kFallback;
   d->flags = kFlagFallback;
-  d->f_safe = SafeStop(terms, qd, state_valid && terms.M.allFinite());
+  const bool use_d = use_disturbance_ && disturbance.force_n.allFinite();
+  d->f_safe = SafeStop(terms, qd, state_valid && terms.M.allFinite(),
+                       use_d ? disturbance.force_n : kNoDisturbance);
   return d->f_safe;
 }
 
-Vector6d SafetyFilter::SafeStop(const DynamicsTerms& terms, const Vector6d& qd,
-                                bool terms_valid) const {
+Vector6d SafetyFilter::SafeStop(const DynamicsTerms& terms, const Vector6d& qd, bool terms_valid,
+                                const Vector6d& disturbance_n) const {
   Vector6d f = Vector6d::Zero();
   if (fallback_ == SafetyFallback::kHold && terms_valid) {
-    // Gravity-compensating brake: qdd = -qd / stop_time_s.
-    f = InverseDynamics(terms, -qd / stop_time_s_);
+    // Gravity-compensating brake: qdd = -qd / stop_time_s, against the
+    // estimated model error too (a payload would otherwise sink).
+    f = InverseDynamics(terms, -qd / stop_time_s_, disturbance_n);
     if (!f.allFinite()) f.setZero();
   }
   if (force_limits_) f = f.cwiseMax(-force_limit_n_).cwiseMin(force_limit_n_);
@@ -213,7 +226,7 @@ Vector6d SafetyFilter::SafeStop(const DynamicsTerms& terms, const Vector6d& qd,
 void SafetyFilter::ApplySafeStop(const StepInput& in, SafetyDiagnostics* d) const {
   d->filter_case = FilterCase::kFallback;
   d->flags |= kFlagFallback;
-  d->f_safe = SafeStop(in.terms, in.qd, true);
+  d->f_safe = SafeStop(in.terms, in.qd, true, in.disturbance_n);
 }
 
 Matrix6d SafetyFilter::MetricMap(const DynamicsTerms& terms) const {

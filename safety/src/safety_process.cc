@@ -119,7 +119,9 @@ SafetyOutput SafetyProcess::Filter(const StateSample& state, const ForceCommand&
 }
 
 SafetyOutput SafetyProcess::Fallback(const StateSample& state, int32_t reason) {
-  const Vector6d f = filter_.SafeStopCommand(state.q, state.qd, &diagnostics_);
+  const Vector6d f = filter_.SafeStopCommand(
+      state.q, state.qd, GeneralizedDisturbance{state.disturbance, state.disturbance_std},
+      &diagnostics_);
   counters_->Count("fallback_commands");
   return Emit(f, state.sample_utime, reason);
 }

@@ -10,6 +10,8 @@
 namespace stewart::safety {
 namespace {
 
+const Vector6d kZero6 = Vector6d::Zero();
+
 // Largest t in [0, 1] such that y + t dy keeps every row of `qp` (which y
 // satisfies, up to rounding).
 double StepKeepingRows(const UncomposedQp& qp, const Vector6d& y, const Vector6d& dy) {
@@ -42,8 +44,8 @@ bool SafetyFilter::BuildUncomposedQp(const DynamicsTerms& terms, const Vector6d&
     return false;  // the velocity rows need M^-1
   }
   ws.metric_map = map;
-  const bool posable =
-      PoseUncomposedQp(StepInput{terms, qd, f_des, b}, ConditionGroups::kAll, ws, &ws.uncomposed);
+  const bool posable = PoseUncomposedQp(StepInput{terms, qd, f_des, b, kZero6},
+                                        ConditionGroups::kAll, ws, &ws.uncomposed);
   *qp = ws.uncomposed.qp;
   if (rows != nullptr) *rows = ws.uncomposed.rows;
   return posable;
@@ -76,7 +78,8 @@ bool SafetyFilter::PoseUncomposedQp(const StepInput& in, ConditionGroups groups,
       const size_t k = static_cast<size_t>(i);
       const double alpha = c.position[k].alpha;
       // alpha_i (dh_i + h_i) - delta_p at F_des (+ friction: barriers.h).
-      const double psi = b.alpha_h_position[k] + alpha * b.dh_position[k] - c.position_margin;
+      const double psi = c.position_rate_per_s * b.alpha_h_position[k] + alpha * b.dh_position[k] -
+                         c.position_margin;
       const ConditionRow r = AppendConditionRow(psi, alpha * g, &qp);
       posable = posable && r.posable;
       rows.position_row[k] = r.row;
@@ -93,7 +96,8 @@ bool SafetyFilter::PoseUncomposedQp(const StepInput& in, ConditionGroups groups,
     for (int i = 0; i < c.num_velocity; ++i) {
       const size_t k = static_cast<size_t>(i);
       const VelocityBarrierSpec& s = c.velocity[k];
-      const double psi = b.alpha_h_velocity[k] + s.alpha_v * b.dh_velocity[k] - c.velocity_margin;
+      const double psi = c.velocity_rate_per_s * b.alpha_h_velocity[k] +
+                         s.alpha_v * b.dh_velocity[k] - c.velocity_margin;
       const ConditionRow r = AppendConditionRow(psi, (s.alpha_v * s.sign) * g.col(s.axis), &qp);
       posable = posable && r.posable;
       rows.velocity_row[k] = r.row;

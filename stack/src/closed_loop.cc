@@ -114,7 +114,10 @@ ClosedLoopSummary RunClosedLoop(const StackConfig& config, const Scenario& scena
       for (const std::string_view a : kAxisNames) *csv << ',' << prefix << a;
     for (const char* prefix : {"fdes_", "fsafe_"})
       for (int i = 1; i <= 6; ++i) *csv << ',' << prefix << i;
-    *csv << ",case,h_pos,h_vel\n";
+    *csv << ",case,h_pos,h_vel";
+    for (const char* prefix : {"dest_", "dstd_"})
+      for (const std::string_view a : kAxisNames) *csv << ',' << prefix << a;
+    *csv << ",psi_v\n";
   }
   Vector6d f_safe = Vector6d::Zero();  // held by the plant until the next command
   for (long k = 0; k < ticks; ++k) {
@@ -200,7 +203,10 @@ ClosedLoopSummary RunClosedLoop(const StackConfig& config, const Scenario& scena
       for (const Vector6d* v : columns)
         for (int i = 0; i < 6; ++i) *csv << ',' << (*v)(i);
       *csv << ',' << (d ? static_cast<int>(d->filter_case) : -1) << ','
-           << (d ? d->barriers.h_pos : 0.0) << ',' << (d ? d->barriers.h_vel : 0.0) << '\n';
+           << (d ? d->barriers.h_pos : 0.0) << ',' << (d ? d->barriers.h_vel : 0.0);
+      for (const Vector6d* v : {&state.disturbance, &state.disturbance_std})
+        for (int i = 0; i < 6; ++i) *csv << ',' << (*v)(i);
+      *csv << ',' << (d ? d->barriers.psi_v : 0.0) << '\n';
     }
     if (!advance(f_safe)) break;
     const Vector6d q1 = plant.q(), qd1 = plant.qd();

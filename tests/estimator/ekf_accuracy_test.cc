@@ -16,7 +16,10 @@ struct Bounds {
 
 // docs/estimator.md, "Measured accuracy".
 constexpr Bounds kConstantVelocityBounds{1e-4, 1e-4, 1e-3, 1e-3};
-constexpr Bounds kDynamicsBounds{5e-5, 5e-5, 3e-4, 3e-4};
+// With the model error d estimated and honest process noise (0.05 m/s^2,
+// 0.5 rad/s^2) the rates are noisier than with the exact-model tuning
+// (0.3 mrad/s before): docs/estimator.md, "Model error".
+constexpr Bounds kDynamicsBounds{5e-5, 5e-5, 4e-4, 7e-4};
 
 Ekf MakeEkf(const StackConfig& c) {
   return Ekf(c.platform, c.actuators, c.sensors, c.estimator, c.home_pose);
@@ -103,9 +106,11 @@ TEST(EkfAccuracy, AblationsAndModelMismatch) {
   }
   // The constant-velocity model does not use the mass: unaffected.
   ExpectWithin(mismatch[0], kConstantVelocityBounds);
-  // The dynamics model tuned for an exact model is not robust to it: this is
-  // why it is not the default (docs/estimator.md).
-  EXPECT_GT(mismatch[1].qd_err.Rms().head<3>().maxCoeff(), kConstantVelocityBounds.velocity_mps);
+  // The dynamics model estimates the mass error as part of d: as accurate
+  // as with the exact model (without d it exceeded the constant-velocity
+  // bounds here: docs/estimator.md, "Model error").
+  ExpectWithin(mismatch[1], kDynamicsBounds);
+  EXPECT_EQ(mismatch[1].Count(kEventDiverged), 0);
 }
 
 }  // namespace

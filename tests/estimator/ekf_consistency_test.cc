@@ -73,9 +73,14 @@ void ExpectConsistent(const NeesSums& s) {
   ExpectWithinTwoSided(s.qd, 6.0 * s.n);
 }
 
+// The truth's white acceleration is double-integrated without feedback, so
+// at the shipped (model-error) noise levels it wanders far from the scenario
+// within the 12 s; the equations are checked at a level that keeps it near.
 StackConfig DynamicsConfig() {
   StackConfig c = EstimatorTestConfig();
   c.estimator.process_model = EstimatorProcessModel::kDynamics;
+  c.estimator.dynamics_accel_std_mps2 = 0.001;
+  c.estimator.dynamics_angaccel_std_radps2 = 0.01;
   return c;
 }
 

@@ -11,7 +11,16 @@ int RunStats::Count(EkfEvent e) const {
   return 0;
 }
 
-const StackConfig& EstimatorTestConfig() { return DefaultStackConfig(); }
+// The shipped config, except that the scenario truth applies each command
+// from its own sample on: no actuator latency to model.
+const StackConfig& EstimatorTestConfig() {
+  static const StackConfig config = [] {
+    StackConfig c = DefaultStackConfig();
+    c.estimator.command_latency_s = 0.0;
+    return c;
+  }();
+  return config;
+}
 
 RunStats RunScenario(const StackConfig& config, unsigned seed, double t_end_s, double settle_s,
                      Ekf* ekf, const RunHooks& hooks, const TruthDisturbance& disturbance) {

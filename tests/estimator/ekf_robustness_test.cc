@@ -62,7 +62,9 @@ TEST(EkfRobustness, RecoversFromBadInitialGuessWithHonestCovariance) {
   Vector6d q0 = c.home_pose;
   q0 += (Vector6d() << 0.01, -0.01, 0.005, 0.03, -0.03, 0.02).finished();
   EkfVector std;
-  std << Vector6d::Constant(0.02), Vector6d::Constant(0.05), Vector3d::Constant(0.01);
+  std << Vector6d::Constant(0.02), Vector6d::Constant(0.05),
+      Vector3d::Constant(c.estimator.initial_disturbance_std_n),
+      Vector3d::Constant(c.estimator.initial_disturbance_std_nm), Vector3d::Constant(0.01);
   ekf.Initialize(-1000, q0, Vector6d::Constant(0.02), std);
   const RunStats s = RunScenario(c, 4, 6.0, 1.0, &ekf, ExpectFiniteEstimates());
   ExpectAccurate(s);
@@ -276,7 +278,8 @@ TEST(EkfEvents, EveryEventHasADistinctName) {
   for (uint32_t bit = 1; bit <= kEventLast; bit <<= 1) {
     names.insert(EkfEventName(static_cast<EkfEvent>(bit)));
   }
-  EXPECT_EQ(names.size(), 15u);
+  EXPECT_EQ(names.size(), 16u);
+  EXPECT_FALSE(IsRejection(kEventDisturbanceJump));
   EXPECT_EQ(names.count("unknown"), 0u);
   EXPECT_TRUE(IsRejection(kGateLegs));
   EXPECT_FALSE(IsRejection(kEventDiverged));

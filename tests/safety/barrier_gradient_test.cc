@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <string>
 
 #include "safety_test_support.h"
 #include "stewart/safety/barriers.h"
@@ -38,41 +39,46 @@ std::pair<double, double> PsiFromTrajectory(const ConstraintSet& c, const Vector
   const Composed plus = ComposedAt(c, q + qd * dt + 0.5 * qdd * dt * dt, qd + qdd * dt);
   const Composed minus = ComposedAt(c, q - qd * dt + 0.5 * qdd * dt * dt, qd - qdd * dt);
   const Composed now = ComposedAt(c, q, qd);
-  return {(plus.h_pos - minus.h_pos) / (2 * dt) + now.h_pos,
-          (plus.h_vel - minus.h_vel) / (2 * dt) + now.h_vel};
+  return {(plus.h_pos - minus.h_pos) / (2 * dt) + c.position_rate_per_s * now.h_pos,
+          (plus.h_vel - minus.h_vel) / (2 * dt) + c.velocity_rate_per_s * now.h_vel};
 }
 
 TEST(BarrierGradient, PsiAndGMatchTheModelsForwardDynamics) {
-  SafetyConfig config = RichSafetyConfig();
-  // Moderate sharpness so the composed barrier is smooth on the scale of the
-  // time step (the formulas do not depend on k).
-  config.k_position = 50.0;
-  config.k_velocity = 50.0;
-  const ConstraintSet c = BuildConstraintSet(DefaultConfig().platform, config);
-  std::mt19937 rng(17);
-  for (int n = 0; n < 60; ++n) {
-    const Vector6d q = RandomPoseInLimits(&rng);
-    const Vector6d qd = RandomVelocity(&rng) * 10.0;  // non-trivial power terms
-    const DynamicsTerms terms = EvaluateDynamics(DefaultConfig().platform, q, qd);
-    const Vector6d f_des = RandomNominalForce(terms, &rng);
-    BarrierEvaluation e;
-    EvaluateBarriers(c, q, qd, terms, f_des, &e);
+  for (const double rate : {1.0, 20.0}) {
+    SCOPED_TRACE("class-K rate " + std::to_string(rate));
+    SafetyConfig config = RichSafetyConfig();
+    config.velocity_rate_per_s = rate;
+    config.position_rate_per_s = 0.5 * rate;
+    // Moderate sharpness so the composed barrier is smooth on the scale of the
+    // time step (the formulas do not depend on k).
+    config.k_position = 50.0;
+    config.k_velocity = 50.0;
+    const ConstraintSet c = BuildConstraintSet(DefaultConfig().platform, config);
+    std::mt19937 rng(17);
+    for (int n = 0; n < 60; ++n) {
+      const Vector6d q = RandomPoseInLimits(&rng);
+      const Vector6d qd = RandomVelocity(&rng) * 10.0;  // non-trivial power terms
+      const DynamicsTerms terms = EvaluateDynamics(DefaultConfig().platform, q, qd);
+      const Vector6d f_des = RandomNominalForce(terms, &rng);
+      BarrierEvaluation e;
+      EvaluateBarriers(c, q, qd, terms, f_des, &e);
 
-    const auto [psi_p, psi_v] = PsiFromTrajectory(c, q, qd, f_des);
-    EXPECT_NEAR(e.psi_p, psi_p, kFdTol * (1.0 + std::fabs(psi_p))) << "sample " << n;
-    EXPECT_NEAR(e.psi_v, psi_v, kFdTol * (1.0 + std::fabs(psi_v))) << "sample " << n;
+      const auto [psi_p, psi_v] = PsiFromTrajectory(c, q, qd, f_des);
+      EXPECT_NEAR(e.psi_p, psi_p, kFdTol * (1.0 + std::fabs(psi_p))) << "sample " << n;
+      EXPECT_NEAR(e.psi_v, psi_v, kFdTol * (1.0 + std::fabs(psi_v))) << "sample " << n;
 
-    Vector6d g_p_fd, g_v_fd;
-    for (int i = 0; i < 6; ++i) {
-      const double eps = 0.5;  // N; Psi is affine in F
-      const Vector6d step = Vector6d::Unit(i) * eps;
-      const auto [pp, vp] = PsiFromTrajectory(c, q, qd, f_des + step);
-      const auto [pm, vm] = PsiFromTrajectory(c, q, qd, f_des - step);
-      g_p_fd(i) = (pp - pm) / (2 * eps);
-      g_v_fd(i) = (vp - vm) / (2 * eps);
+      Vector6d g_p_fd, g_v_fd;
+      for (int i = 0; i < 6; ++i) {
+        const double eps = 0.5;  // N; Psi is affine in F
+        const Vector6d step = Vector6d::Unit(i) * eps;
+        const auto [pp, vp] = PsiFromTrajectory(c, q, qd, f_des + step);
+        const auto [pm, vm] = PsiFromTrajectory(c, q, qd, f_des - step);
+        g_p_fd(i) = (pp - pm) / (2 * eps);
+        g_v_fd(i) = (vp - vm) / (2 * eps);
+      }
+      EXPECT_LE((e.g_p - g_p_fd).norm(), kFdTol * (e.g_p.norm() + 1e-3)) << "sample " << n;
+      EXPECT_LE((e.g_v - g_v_fd).norm(), kFdTol * e.g_v.norm()) << "sample " << n;
     }
-    EXPECT_LE((e.g_p - g_p_fd).norm(), kFdTol * (e.g_p.norm() + 1e-3)) << "sample " << n;
-    EXPECT_LE((e.g_v - g_v_fd).norm(), kFdTol * e.g_v.norm()) << "sample " << n;
   }
 }
 

@@ -21,6 +21,10 @@ SafetyConfig RichSafetyConfig() {
   s.k_velocity = 2e4;
   s.velocity_robust_margin_mps2 = 0.0;
   s.position_robust_margin_w = 0.0;
+  // The paper's unit class-K rates: the velocity conditions bind on more of
+  // the random states (BarrierGradient also checks other rates).
+  s.velocity_rate_per_s = 1.0;
+  s.position_rate_per_s = 1.0;
   s.position_limits = {
       {0, -0.08, 0.11, 1.0, 1.0},
       {1, -0.10, 0.11, 1.5, 0.8},

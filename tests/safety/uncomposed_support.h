@@ -37,12 +37,14 @@ inline SingleBarrierConditions EvaluateSingleBarrierConditions(const SafetyFilte
   const Matrix6d h_t_m_inv = terms.H.transpose() * terms.M.inverse();
   for (size_t i = 0; i < static_cast<size_t>(c.num_position); ++i) {
     const double alpha = c.position[i].alpha;
-    s.psi_position[i] = e.alpha_h_position[i] + alpha * e.dh_position[i] - c.position_margin;
+    s.psi_position[i] = c.position_rate_per_s * e.alpha_h_position[i] + alpha * e.dh_position[i] -
+                        c.position_margin;
     s.n_position[i] = -alpha * (terms.H.transpose() * qd);
   }
   for (size_t i = 0; i < static_cast<size_t>(c.num_velocity); ++i) {
     const VelocityBarrierSpec& v = c.velocity[i];
-    s.psi_velocity[i] = e.alpha_h_velocity[i] + v.alpha_v * e.dh_velocity[i] - c.velocity_margin;
+    s.psi_velocity[i] = c.velocity_rate_per_s * e.alpha_h_velocity[i] +
+                        v.alpha_v * e.dh_velocity[i] - c.velocity_margin;
     s.n_velocity[i] = v.alpha_v * v.sign * h_t_m_inv.col(v.axis);
   }
   return s;

@@ -24,5 +24,10 @@ Vector6d PdAcceleration(const ControllerConfig& gains, const Vector6d& q, const 
 Vector6d NominalForce(const PlatformParams& platform, const ControllerConfig& gains,
                       const Vector6d& q, const Vector6d& qd, const Setpoint& setpoint,
                       DynamicsTerms* terms);
+/// The same, cancelling the estimated model error d (model/disturbance.h):
+///   H (F_des + F_friction) + d = M u + C qd + G.
+Vector6d NominalForce(const PlatformParams& platform, const ControllerConfig& gains,
+                      const Vector6d& q, const Vector6d& qd, const Vector6d& disturbance_n,
+                      const Setpoint& setpoint, DynamicsTerms* terms);
 
 }  // namespace stewart

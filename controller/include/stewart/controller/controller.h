@@ -58,6 +58,10 @@ class Controller {
   /// One control step for the state at `utime` (us). On kOk fills `out`; on
   /// any other status `out` is untouched and nothing must be published.
   StepStatus Step(int64_t utime, const Vector6d& q, const Vector6d& qd, ControllerOutput* out);
+  /// The same with the state's estimate of the model error d (N, N m per rad;
+  /// model/disturbance.h), cancelled when gains.compensate_disturbance.
+  StepStatus Step(int64_t utime, const Vector6d& q, const Vector6d& qd,
+                  const Vector6d& disturbance_n, ControllerOutput* out);
 
   bool following_scenario() const { return scenario_.has_value(); }
   const std::optional<Scenario>& scenario() const { return scenario_; }

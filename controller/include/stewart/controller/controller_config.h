@@ -11,8 +11,10 @@ struct ControllerConfig {
   /// the legs' viscous friction, leg_friction_nspm = actuators.viscous_friction_nspm
   /// (set by ParseStackConfig), else 0.
   bool compensate_friction = true;
+  /// Optional key `compensate_disturbance` (default true): F_des also cancels
+  /// the state's estimate of the model error d (docs/controller.md).
+  bool compensate_disturbance = true;
   double leg_friction_nspm = 0.0;  ///< N per m/s of leg speed
 };
-
 
 }  // namespace stewart

@@ -1,6 +1,6 @@
 #pragma once
 // Extended Kalman filter fusing the leg potentiometers and the IMU into the
-// platform state [q, qd] plus the gyro bias. docs/estimator.md describes the
+// platform state [q, qd], the model error d and the gyro bias. docs/estimator.md describes the
 // model, the tuning and the measured accuracy. No LCM, no heap allocation
 // per update, and time only from the samples' utime.
 #include <array>
@@ -72,7 +72,7 @@ class Ekf {
   bool initialized_ = false;
   int64_t last_utime_ = 0;
   EkfVector x_ = EkfVector::Zero();
-  /// P in a 16x16 matrix whose last row and column are zero: every column is
+  /// P in a 22x22 matrix whose last row and column are zero: every column is
   /// a whole number of SIMD packets.
   using PaddedMatrix = Eigen::Matrix<double, kEkfStateSize + 1, kEkfStateSize + 1>;
   PaddedMatrix P_ = PaddedIdentity();
@@ -81,10 +81,22 @@ class Ekf {
   bool qdd_from_dynamics_ = false;
   Matrix6d dqdd_dq_ = Matrix6d::Zero();  ///< dynamics model, at the last predict
   Matrix6d dqdd_dqd_ = Matrix6d::Zero();
-  bool has_command_ = false;
-  int64_t command_utime_ = 0;
-  Vector6d command_n_ = Vector6d::Zero();
+  Matrix6d m_inv_ = Matrix6d::Zero();  ///< dqdd/dd = M^-1, at the last predict
+  /// The latest commands (sample utime, force), newest at
+  /// command_history_[(command_next_ - 1) % kCommandHistory]: the model
+  /// applies the one issued command_latency_s before each interval.
+  struct TimedCommand {
+    int64_t utime = 0;
+    Vector6d force_n = Vector6d::Zero();
+  };
+  static constexpr int kCommandHistory = 16;
+  std::array<TimedCommand, kCommandHistory> command_history_{};
+  int command_next_ = 0;
+  int command_count_ = 0;
+  /// The command acting from `interval_start_utime` on, or nullptr.
+  const TimedCommand* ActingCommand(int64_t interval_start_utime) const;
   int consecutive_leg_rejections_ = 0;
+  int consecutive_accel_gated_ = 0;
   int samples_since_init_ = 0;
   bool diverged_ = false;
   double last_leg_nis_ = 0.0;

@@ -7,12 +7,15 @@
 
 namespace stewart {
 
-/// EKF state x = [q (6), qd (6), b_g (3)]: pose (m, rad; Z-Y-X Euler), its
-/// time derivative (m/s, rad/s Euler rates), gyro bias (rad/s, {P} axes).
-constexpr int kEkfStateSize = 15;
+/// EKF state x = [q (6), qd (6), d (6), b_g (3)]: pose (m, rad; Z-Y-X
+/// Euler), its time derivative (m/s, rad/s Euler rates), the model error d
+/// of M qdd + C qd + G = H F + d (N, N m per rad; model/disturbance.h), gyro
+/// bias (rad/s, {P} axes).
+constexpr int kEkfStateSize = 21;
 constexpr int kEkfQ = 0;
 constexpr int kEkfQd = 6;
-constexpr int kEkfGyroBias = 12;
+constexpr int kEkfDisturbance = 12;
+constexpr int kEkfGyroBias = 18;
 using EkfVector = Eigen::Matrix<double, kEkfStateSize, 1>;
 using EkfMatrix = Eigen::Matrix<double, kEkfStateSize, kEkfStateSize>;
 
@@ -36,8 +39,10 @@ struct Estimate {
   Vector6d q_std = Vector6d::Zero();
   Vector6d qd_std = Vector6d::Zero();
   Vector3d gyro_bias_radps = Vector3d::Zero();
-  bool initializing = false;  ///< within settle_samples of a (re)initialisation
-  bool diverged = false;      ///< a divergence was detected and the filter restarted
+  Vector6d disturbance_n = Vector6d::Zero();      ///< d (N, N m per rad)
+  Vector6d disturbance_std_n = Vector6d::Zero();  ///< its one-sigma uncertainty
+  bool initializing = false;                      ///< within settle_samples of a (re)initialisation
+  bool diverged = false;  ///< a divergence was detected and the filter restarted
 };
 
 /// Events of one update, as a bit set. Rejections are bad or inconsistent
@@ -58,7 +63,11 @@ enum EkfEvent : uint32_t {
   kGateAccel = 1u << 12,
   kGateOrientation = 1u << 13,
   kRejectInitFailed = 1u << 14,  ///< forward kinematics did not converge
-  kEventLast = kRejectInitFailed,
+  /// The accelerometer disagreed with the predicted acceleration beyond its
+  /// gate: d's uncertainty was re-opened (a push, a payload change) and the
+  /// sample used again.
+  kEventDisturbanceJump = 1u << 15,
+  kEventLast = kEventDisturbanceJump,
 };
 
 /// Short snake_case name of one event bit (health counter names).

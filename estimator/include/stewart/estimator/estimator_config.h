@@ -18,6 +18,19 @@ struct EstimatorConfig {
   /// Dynamics model: std of the model error as an acceleration.
   double dynamics_accel_std_mps2 = 0.001;
   double dynamics_angaccel_std_radps2 = 0.01;
+  /// Model error d (docs/estimator.md, "Model error"): estimated with the
+  /// dynamics model only. A random walk (per sqrt(s)), its initial std, and
+  /// the std it is re-opened to when the accelerometer shows a jump; force
+  /// rows (N) and Euler-angle rows (N m per rad).
+  bool estimate_disturbance = false;
+  double disturbance_walk_n_per_sqrt_s = 1.0;
+  double disturbance_walk_nm_per_sqrt_s = 0.1;
+  double initial_disturbance_std_n = 2.0;
+  double initial_disturbance_std_nm = 0.2;
+  double disturbance_jump_std_n = 5.0;
+  double disturbance_jump_std_nm = 0.5;
+  /// Consecutive gated accelerometer samples that make a jump.
+  int disturbance_jump_after_samples = 5;
   /// Random walk of the gyro bias (rad/s per sqrt(s)).
   double gyro_bias_walk_radps_per_sqrt_s = 1.0e-5;
   double initial_velocity_std_mps = 0.05;
@@ -31,14 +44,17 @@ struct EstimatorConfig {
   /// Consecutive rejected leg updates after which the filter is diverged and
   /// re-initialised from forward kinematics.
   int divergence_rejections = 50;
-  double max_dt_s = 0.05;            ///< larger sample gaps re-initialise
-  double command_timeout_s = 0.05;   ///< older commands are not used
+  double max_dt_s = 0.05;           ///< larger sample gaps re-initialise
+  double command_timeout_s = 0.05;  ///< older commands are not used
+  /// Optional key: the actuators act this long after the sample a command
+  /// derives from (s): the model applies the command issued that long before
+  /// each predicted interval. At most 15 samples (the history kept).
+  double command_latency_s = 0.0;
   int settle_samples = 200;          ///< STATUS_INITIALIZING after (re)init
   double max_gyro_radps = 35.0;      ///< larger readings are rejected
   double max_accel_mps2 = 160.0;     ///< larger readings are rejected
   double leg_range_margin_m = 0.01;  ///< accepted beyond the stroke ends
   bool perfect_state = false;        ///< pass ground truth through; testing only
 };
-
 
 }  // namespace stewart

@@ -31,5 +31,14 @@ void DynamicsAccelerationJacobians(const PlatformParams& params, double friction
                                    const Vector6d& q, const EulerAngleTrig& trig,
                                    const Vector6d& qd, const Vector6d& force_n, Vector6d* qdd,
                                    Matrix6d* dqdd_dq, Matrix6d* dqdd_dqd);
+/// The same with the model error d added to H F (model/disturbance.h):
+/// qdd = M^-1 (H (F - c_v ld) + d - C qd - G), and dqdd/dd = M^-1 in
+/// `m_inv`. d is constant in q, so the other Jacobians are those above (the
+/// inertial part -M^-1 dM/dq qdd, which d enters, is left out as there).
+void DynamicsAccelerationJacobians(const PlatformParams& params, double friction_nspm,
+                                   const Vector6d& q, const EulerAngleTrig& trig,
+                                   const Vector6d& qd, const Vector6d& force_n,
+                                   const Vector6d& disturbance_n, Vector6d* qdd, Matrix6d* dqdd_dq,
+                                   Matrix6d* dqdd_dqd, Matrix6d* m_inv);
 
 }  // namespace stewart

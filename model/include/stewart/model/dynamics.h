@@ -50,6 +50,10 @@ Vector6d GeneralisedForceOfWrench(const Vector6d& q, const Vector6d& wrench_in_B
 /// poses; NaN where it is not (callers check: the controller rejects a
 /// non-finite force, the filter falls back).
 Vector6d InverseDynamics(const DynamicsTerms& terms, const Vector6d& qdd);
+/// The same with an external generalised force Q acting besides H F (the
+/// model error d, model/disturbance.h): H F = M qdd + C qd + G - Q.
+Vector6d InverseDynamics(const DynamicsTerms& terms, const Vector6d& qdd,
+                         const Vector6d& external_generalised_force);
 
 /// Viscous friction of the legs' lead screws, as leg forces (N):
 ///   F_friction = -b ld,   ld = J_l qd = H^T qd  (leg speed, m/s; b in N s/m).

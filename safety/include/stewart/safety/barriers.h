@@ -10,7 +10,7 @@
 // Velocity barrier i (paper eqs. 12-14), a_i = dh_v,i/dqd = sign_i e_j:
 //   dh_v,i = a_i^T M^-1 (H F - C qd - G)
 // Group composition (alpha-weighted LSE, log_sum_exp.h), per group:
-//   h_c = LSE_k(alpha_i h_i),  psi = sum_i alpha_i w_i dh_i(F_des) + h_c,
+//   h_c = LSE_k(alpha_i h_i),  psi = sum_i alpha_i w_i dh_i(F_des) + gamma h_c,
 //   g = sum_i alpha_i w_i dh_i/dF
 // so g_p = (sum_i alpha_i w_i) (-H^T qd) and g_v = H^T M^-1 sum_i alpha_i w_i a_i.
 //

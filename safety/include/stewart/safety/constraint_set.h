@@ -69,6 +69,11 @@ struct ConstraintSet {
   /// within this many standard deviations of the estimate (barriers.h).
   double disturbance_sigma = 0.0;
   bool has_recovery = false;  ///< recovery barriers are in the velocity group
+  /// gamma of each group's condition Psi_c = dh_c + gamma h_c (1/s; the
+  /// paper's is 1): a condition missing an acceleration error e leaves the
+  /// composed barrier at about -e / gamma (docs/safety.md "Model error").
+  double position_rate_per_s = 1.0;
+  double velocity_rate_per_s = 1.0;
 };
 
 inline void RecoveryTarget(const VelocityBarrierSpec& s, double h, double* phi, double* dphi_dh) {

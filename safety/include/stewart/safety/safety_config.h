@@ -88,6 +88,10 @@ struct SafetyConfig {
   /// set"); 0 leaves them out. Default 20: inactive more than
   /// (velocity limit) / kappa, under 1 mm, inside a position limit.
   double recovery_gain_per_s = 20.0;
+  /// Optional keys: gamma of the composed conditions Psi = dh_c + gamma h_c
+  /// (1/s), default 1 as in the paper (docs/safety.md, "Model error").
+  double position_rate_per_s = 1.0;
+  double velocity_rate_per_s = 1.0;
   /// Optional keys: use the state's disturbance estimate d (model/disturbance.h)
   /// in every barrier derivative, and take each derivative at the worst d
   /// within disturbance_sigma standard deviations of it (docs/safety.md,

@@ -58,6 +58,11 @@ class SafetyFilter {
   /// exists (stale or missing): flagged kFlagFallback, case kFallback. Zero
   /// force if the state itself is not finite.
   Vector6d SafeStopCommand(const Vector6d& q, const Vector6d& qd, SafetyDiagnostics* diagnostics);
+  /// The same, holding against the estimated model error d too (ignored
+  /// when not finite or when safety.use_disturbance_estimate is false).
+  Vector6d SafeStopCommand(const Vector6d& q, const Vector6d& qd,
+                           const GeneralizedDisturbance& disturbance,
+                           SafetyDiagnostics* diagnostics);
 
   /// T of the correction metric at these model terms (docs/safety.md): with
   /// F = T y the cost (F - F_des)^T W (F - F_des) is ||y - y_des||^2, and
@@ -119,9 +124,11 @@ class SafetyFilter {
     const Vector6d& qd;
     const Vector6d& f_des;
     const BarrierEvaluation& barriers;
+    const Vector6d& disturbance_n;  ///< d the safe stop holds against (0 if unused)
   };
 
-  Vector6d SafeStop(const DynamicsTerms& terms, const Vector6d& qd, bool terms_valid) const;
+  Vector6d SafeStop(const DynamicsTerms& terms, const Vector6d& qd, bool terms_valid,
+                    const Vector6d& disturbance_n) const;
   /// The safe stop as the answer of a step whose QP has no solution.
   void ApplySafeStop(const StepInput& in, SafetyDiagnostics* d) const;
   bool ComputeMetricMap(const DynamicsTerms& terms, const BarrierIntermediates& x,
