@@ -2,10 +2,10 @@
 // payload truth, the EKF, the controller and the safety filter, on the
 // identify scenario), and its answers to data it cannot use.
 //
-// The stack is given the payload's mass and CoM as a prior (as if weighed):
-// with the config's platform it cannot carry the payload at all, the
-// platform sinks onto its end stops (docs/hardware.md, "Identify the
-// platform and its payload"). Its inertia stays the bare plate's. The fit
+// The stack is given the payload's mass and CoM as a rough prior (as if
+// weighed and placed by hand): with the config's platform it cannot carry the
+// payload, the platform sinks onto its end stops (docs/hardware.md, "Identify
+// the platform and its payload"). Its inertia stays the bare plate's. The fit
 // never reads the prior (FitIgnoresThePlatformBodyOfTheModel).
 #include "stewart/identify/inertial_fit.h"
 
@@ -38,21 +38,20 @@ platform:
 const std::string kIdentifyOverlay =
     std::string(STEWART_SOURCE_DIR) + "/config/overlays/identify.yaml";
 
-// The plant: the config's platform with the payload.
-PlatformParams PlantPlatform() {
-  const StackConfig base = LoadStackConfig(DefaultConfigPath());
-  return ParsePlantTruth(base, LoadYamlFile(DefaultConfigPath()), YAML::Load(kPayloadTruth))
-      .platform;
-}
-
-// The prior the stack runs with: the plant's mass and CoM, the bare plate's inertia.
+// The prior the stack runs with: the payload as weighed and placed by hand,
+// 1 g heavy and 5 mm off in x and y (CoM 2 mm off the plant's, 11 % of its
+// distance from {P}'s origin), the bare plate's inertia (9 % off).
 std::string PriorOverlayPath() {
   static const std::string path = [] {
-    const PlatformParams plant = PlantPlatform();
-    const Vector3d& c = plant.platform_com_in_P_m;
+    Payload measured;
+    measured.mass_kg = 0.251;
+    measured.position_in_P_m = Vector3d(0.055, -0.025, 0.02);
+    const PlatformParams prior =
+        WithPayload(LoadStackConfig(DefaultConfigPath()).platform, measured);
+    const Vector3d& c = prior.platform_com_in_P_m;
     char text[256];
     std::snprintf(text, sizeof text, "platform: {mass_kg: %.17g, com_m: [%.17g, %.17g, %.17g]}\n",
-                  plant.platform_mass_kg, c.x(), c.y(), c.z());
+                  prior.platform_mass_kg, c.x(), c.y(), c.z());
     const std::string p =
         ::testing::TempDir() + "identify_prior_" + std::to_string(::getpid()) + ".yaml";
     std::ofstream(p) << text;
