@@ -131,10 +131,11 @@ std::vector<Window> BuildWindows(const PlatformParams& model, double friction_ns
 // Least squares of the weighted rows, columns scaled to unit norm so the
 // condition number compares the parameters' influence, not their units.
 struct Solution {
-  InertialParameters pi;
-  InertialCovariance inverse_normal;  // (A_w^T A_w)^-1
-  double condition_number;
-  InertialParameters weakest_direction;  // right singular vector of the smallest value
+  InertialParameters pi = InertialParameters::Zero();
+  InertialCovariance inverse_normal = InertialCovariance::Zero();  // (A_w^T A_w)^-1
+  double condition_number = INFINITY;
+  // The right singular vector of the smallest singular value.
+  InertialParameters weakest_direction = InertialParameters::Zero();
 };
 
 Solution Solve(const Eigen::MatrixXd& A, const Eigen::VectorXd& y) {

@@ -120,8 +120,11 @@ int Identify(const Options& o) {
                                                                : config.lcm.channels.state_estimate;
   const stewart::identify::LogSamples log =
       stewart::identify::ReadLogSamples(log_path, state_channel, config.lcm.channels.command_safe);
-  spdlog::info("{}: {} states on {} ({} unusable), {} safe commands; {} paired samples", log_path,
-               log.states, state_channel, log.unusable_states, log.commands, log.samples.size());
+  spdlog::info(
+      "{}: {} states on {} ({} unusable, {} without a recorded command), {} safe commands; {} "
+      "paired samples",
+      log_path, log.states, state_channel, log.unusable_states, log.unanswered_states, log.commands,
+      log.samples.size());
   stewart::identify::InertialFitOptions fit_options;
   fit_options.window_s = o.window_s;
   const stewart::identify::InertialFit fit = stewart::identify::FitInertialParameters(
@@ -189,5 +192,8 @@ int main(int argc, char** argv) {
   } catch (const stewart::InputError& e) {
     spdlog::error("{}", e.what());
     return ToInt(ExitCode::kBadInput);
+  } catch (const std::exception& e) {
+    spdlog::error("stewart_identify: {}", e.what());
+    return ToInt(ExitCode::kFault);
   }
 }
