@@ -16,6 +16,8 @@ usage: tools/launch.sh [options]
   --realtime            wall-clock paced at the sensor rate (default for hw)
   --scenario NAME|FILE  config/scenarios/NAME.yaml (default: paper)
   --config FILE         stack config (default: config/platform.yaml)
+  --overlay FILE        YAML overlay: its keys replace the config's (repeatable, applied
+                        in order; the run folder's config.yaml is the merged config)
   --truth FILE          the plant's physics differ from the config (plant_sim or the
                         device emulator only; docs/simulation.md, "Truth")
   --seed N              sensor noise and disturbance seed of the simulated plant
@@ -39,6 +41,7 @@ USAGE
 PLANT=sim MODE="" SCENARIO=paper CONFIG="$ROOT/config/platform.yaml" VARIANT="" DURATION=""
 LOG="" DO_LOG=1 DO_REPORT=1 SPY=0 URL="" OUT="" EMULATOR=0 BUILD_FIRST=1 LCM_LOGGER=0 RT_PRIORITY='' LOOP_CPU=auto
 TRUTH="" SEED=
+OVERLAYS=()
 ARGS="$*"
 while (($#)); do
   case "$1" in
@@ -48,6 +51,8 @@ while (($#)); do
     --realtime) MODE=realtime ;;
     --scenario) SCENARIO=$2; shift ;;
     --config) CONFIG=$(realpath "$2"); shift ;;
+    --overlay) [[ -f $2 ]] || { echo "launch: overlay '$2' not found" >&2; exit 2; }
+               OVERLAYS+=("$(realpath "$2")"); shift ;;
     --variant) VARIANT=$2; shift ;;
     --truth) TRUTH=$(realpath "$2") || exit 2; shift ;;
     --seed) SEED=$2; shift ;;
@@ -117,19 +122,29 @@ bin() { # path of a built program, or fail naming it
 PLANT_SIM=$(bin plant_sim) ESTIMATOR=$(bin estimator) CONTROLLER=$(bin controller)
 SAFETY=$(bin safety) MONITOR=$(bin stewart_stack_monitor) LOGGER=$(bin stewart_logger)
 
-[[ -n $DURATION ]] || DURATION=$("$CONTROLLER" --config "$CONFIG" --scenario "$SCENARIO" --print-duration)
 STAMP=$(date +%Y%m%d-%H%M%S)
 [[ -n $OUT ]] || OUT="$ROOT/runs/$STAMP-$(basename "$SCENARIO" .yaml)"
 mkdir -p "$OUT"
+# Everything needed to reproduce the run sits beside the log. With overlays
+# the config.yaml there is the merged config every process loads (each gets
+# the file and the overlays: a plant's truth overrides the file, not what
+# the overlays make the stack believe), so replay and the report read what ran.
+OVERLAY_ARGS=()
+for f in "${OVERLAYS[@]}"; do OVERLAY_ARGS+=(--overlay "$f"); done
+if ((${#OVERLAYS[@]})); then
+  "$(bin stewart_config_merge)" --config "$CONFIG" "${OVERLAY_ARGS[@]}" --out "$OUT/config.yaml" ||
+    { echo "launch: the overlays do not apply to $CONFIG" >&2; exit 2; }
+else
+  cp "$CONFIG" "$OUT/config.yaml"
+fi
+[[ -n $DURATION ]] || DURATION=$("$CONTROLLER" --config "$CONFIG" "${OVERLAY_ARGS[@]}" --scenario "$SCENARIO" --print-duration)
 [[ -n $LOG ]] || LOG="$OUT/log.lcm"
 if [[ -z $URL ]]; then
   # A private multicast port per run (ttl=0: nothing leaves this machine).
   URL="udpm://239.255.76.67:$((20000 + RANDOM % 20000))?ttl=0"
 fi
-COMMON=(--config "$CONFIG" --lcm-url "$URL")
+COMMON=(--config "$CONFIG" "${OVERLAY_ARGS[@]}" --lcm-url "$URL")
 
-# Everything needed to reproduce the run sits beside the log.
-cp "$CONFIG" "$OUT/config.yaml"
 if [[ -f $SCENARIO ]]; then cp "$SCENARIO" "$OUT/scenario.yaml"
 else cp "$ROOT/config/scenarios/$SCENARIO.yaml" "$OUT/scenario.yaml"; fi
 {
@@ -140,6 +155,7 @@ else cp "$ROOT/config/scenarios/$SCENARIO.yaml" "$OUT/scenario.yaml"; fi
   echo "scenario: $SCENARIO"
   echo "duration_s: $DURATION"
   echo "variant: ${VARIANT:-from config}"
+  ((${#OVERLAYS[@]})) && echo "overlays: [$(IFS=,; echo "${OVERLAYS[*]}" | sed 's/,/, /g')]"
   echo "rt_priority: $RT_PRIORITY"
   echo "loop_cpu: $LOOP_CPU"
   echo "lcm_url: $URL"

@@ -1,3 +1,5 @@
+#include <Eigen/Eigenvalues>
+
 #include "stewart/config/sections.h"
 
 namespace stewart {
@@ -15,13 +17,26 @@ PlatformParams ParsePlatformParams(const ConfigNode& root) {
   p.platform_mass_kg = platform.PositiveDouble("mass_kg");
   p.platform_com_in_P_m = platform.Vec3("com_m");
   p.platform_inertia_kgm2 = platform.Vec3("inertia_kgm2");
+  // Optional (zero for a body symmetric about {P}'s axes): an identified
+  // platform or one with a payload off the axes has them.
+  if (platform.Has("inertia_products_kgm2")) {
+    p.platform_inertia_products_kgm2 = platform.Vec3("inertia_products_kgm2");
+  }
   for (int i = 0; i < 3; ++i) {
     if (!(p.platform_inertia_kgm2(i) > 0.0)) {
       platform.Fail("inertia_kgm2", "principal inertias must be positive");
     }
   }
-  const Vector3d I = p.platform_inertia_kgm2;
-  if (I(0) + I(1) < I(2) || I(1) + I(2) < I(0) || I(0) + I(2) < I(1)) {
+  // A rigid body's principal moments obey the triangle inequality; with
+  // products of inertia the principal moments are the tensor's eigenvalues.
+  const Vector3d I = Eigen::SelfAdjointEigenSolver<Matrix3d>(PlatformInertiaInP(p)).eigenvalues();
+  if (!(I.minCoeff() > 0.0)) {
+    platform.Fail("inertia_products_kgm2", "the inertia tensor is not positive definite");
+  }
+  // (A flat plate sits on the bound; the eigen-solver's rounding must not fail it.)
+  const double tolerance = 1e-12 * I.sum();
+  if (I(0) + I(1) < I(2) - tolerance || I(1) + I(2) < I(0) - tolerance ||
+      I(0) + I(2) < I(1) - tolerance) {
     platform.Fail("inertia_kgm2", "violates the triangle inequality of a rigid body");
   }
   p.gravity_mps2 = platform.NonNegativeDouble("gravity_mps2");

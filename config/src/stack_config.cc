@@ -107,6 +107,20 @@ YAML::Node LoadYamlFile(const std::string& path) {
 
 StackConfig LoadStackConfig(const std::string& path) { return ParseRoot(LoadYamlFile(path), path); }
 
+StackConfig LoadStackConfig(const std::string& path,
+                            const std::vector<std::string>& overlay_paths) {
+  return ParseRoot(LoadMergedConfigYaml(path, overlay_paths), path);
+}
+
+YAML::Node LoadMergedConfigYaml(const std::string& path,
+                                const std::vector<std::string>& overlay_paths) {
+  YAML::Node merged = LoadYamlFile(path);
+  for (const std::string& overlay : overlay_paths) {
+    ApplyConfigOverlay(LoadYamlFile(overlay), overlay, &merged);
+  }
+  return merged;
+}
+
 std::string DefaultConfigPath() {
   if (const char* env = std::getenv("STEWART_CONFIG"); env != nullptr && *env != '\0') {
     return env;

@@ -197,9 +197,6 @@ PlantTruth ParsePlantTruth(const StackConfig& config, const YAML::Node& config_r
 
   const ConfigNode platform = root.Child("platform");
   const YAML::Node platform_yaml = merged["platform"];
-  if (platform.Has("inertia_products_kgm2")) {
-    t.platform.platform_inertia_products_kgm2 = platform.Vec3("inertia_products_kgm2");
-  }
   ApplyJointRadiusOffsets(platform, platform_yaml, "base_joint_radius_offsets_m",
                           &t.platform.base_joints_in_B_m);
   ApplyJointRadiusOffsets(platform, platform_yaml, "platform_joint_radius_offsets_m",
@@ -272,6 +269,8 @@ PlantTruth LoadPlantTruth(const StackConfig& config, const std::string& truth_pa
   if (config.source_path.empty()) {
     throw ConfigError("<truth>", "a truth file needs the stack config loaded from a file");
   }
+  // The base file, not its overlays: overlays change what the stack believes
+  // (e.g. identified mass properties), a truth what the simulated plant is.
   return ParsePlantTruth(config, LoadYamlFile(config.source_path), LoadYamlFile(truth_path));
 }
 

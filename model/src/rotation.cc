@@ -52,6 +52,17 @@ Vector3d EulerRateBiasAcceleration(const EulerAngleTrig& trig, const Vector3d& r
   return fd * dcol0 + td * dcol1;
 }
 
+Matrix3d EulerRateMatrixDerivative(const EulerAngleTrig& trig, const Vector3d& rpy_rate_radps) {
+  const double ct = trig.cos_theta, st = trig.sin_theta;
+  const double cp = trig.cos_psi, sp = trig.sin_psi;
+  const double td = rpy_rate_radps.y(), pd = rpy_rate_radps.z();
+  Matrix3d Ed;
+  Ed << -cp * st * td - sp * ct * pd, -cp * pd, 0.0,  //
+      -sp * st * td + cp * ct * pd, -sp * pd, 0.0,    //
+      -ct * td, 0.0, 0.0;
+  return Ed;
+}
+
 Vector3d EulerRateBiasAcceleration(const Vector3d& rpy_rad, const Vector3d& rpy_rate_radps) {
   return EulerRateBiasAcceleration(EulerAngleTrig(rpy_rad), rpy_rate_radps);
 }

@@ -1,7 +1,4 @@
-#include "stewart/config/config_loader.h"
 #include "stewart/node/node_options.h"
-
-#include "stewart/node/exit_code.h"
 
 #include <sched.h>
 #include <spdlog/spdlog.h>
@@ -11,11 +8,17 @@
 #include <cstdlib>
 #include <cstring>
 
+#include "stewart/config/config_loader.h"
+#include "stewart/node/exit_code.h"
+
 namespace stewart {
 
 void AddNodeOptions(CLI::App* app, NodeOptions* options) {
   options->config_path = DefaultConfigPath();
   app->add_option("-c,--config", options->config_path, "YAML config")->capture_default_str();
+  app->add_option("--overlay", options->overlay_paths,
+                  "YAML overlay: its keys replace the config's (repeatable, applied in order)")
+      ->check(CLI::ExistingFile);
   app->add_option("--lcm-url", options->lcm_url, "LCM URL (default: lcm.url of the config)");
   app->add_option("--channel-suffix", options->channel_suffix,
                   "suffix appended to every channel name");
@@ -25,7 +28,7 @@ void AddNodeOptions(CLI::App* app, NodeOptions* options) {
 
 StackConfig LoadNodeConfig(const NodeOptions& options) {
   spdlog::set_level(spdlog::level::from_str(options.log_level));
-  StackConfig config = LoadStackConfig(options.config_path);
+  StackConfig config = LoadStackConfig(options.config_path, options.overlay_paths);
   if (!options.lcm_url.empty()) config.lcm.url = options.lcm_url;
   if (!options.channel_suffix.empty()) SetChannelSuffix(&config.lcm, options.channel_suffix);
   return config;

@@ -15,9 +15,12 @@
 
 namespace stewart {
 
-/// The stack config (its file, config.source_path) overridden by the truth
-/// file; TruthOfConfig when truth_path is empty. The sensors' rate and seed
-/// stay the config's: they are how the simulation runs, not physics.
+/// The stack config's file (config.source_path, without the overlays the
+/// config may have been loaded with: overlays change what the stack
+/// believes, the truth is the plant) overridden by the truth file;
+/// TruthOfConfig (the config as loaded, overlays included) when truth_path
+/// is empty. The sensors' rate and seed stay the config's: they are how the
+/// simulation runs, not physics.
 /// Throws ConfigError naming the key ("truth.platform.payload.mass_kg").
 PlantTruth LoadPlantTruth(const StackConfig& config, const std::string& truth_path);
 

@@ -29,6 +29,10 @@ Matrix3d EulerRateMatrix(const EulerAngleTrig& trig);
 Vector3d EulerRateBiasAcceleration(const Vector3d& rpy_rad, const Vector3d& rpy_rate_radps);
 Vector3d EulerRateBiasAcceleration(const EulerAngleTrig& trig, const Vector3d& rpy_rate_radps);
 
+/// Edot(r, rd), the time derivative of E (1/s): the matrix itself, for the
+/// terms that need Edot^T (the generalised momentum's rate, identification).
+Matrix3d EulerRateMatrixDerivative(const EulerAngleTrig& trig, const Vector3d& rpy_rate_radps);
+
 /// Inverse of RotationFromEuler for theta in (-pi/2, pi/2).
 Vector3d EulerFromRotation(const Matrix3d& R);
 

@@ -1,6 +1,7 @@
 #pragma once
 #include <CLI/CLI.hpp>
 #include <string>
+#include <vector>
 
 #include "stewart/config/stack_config.h"
 
@@ -10,8 +11,9 @@ namespace stewart {
 /// overrides (launch.sh gives each run a private URL).
 struct NodeOptions {
   std::string config_path;
-  std::string lcm_url;         ///< "" = lcm.url from the config
-  std::string channel_suffix;  ///< "" = lcm.channel_suffix from the config
+  std::vector<std::string> overlay_paths;  ///< --overlay, applied to the config in order
+  std::string lcm_url;                     ///< "" = lcm.url from the config
+  std::string channel_suffix;              ///< "" = lcm.channel_suffix from the config
   std::string log_level = "info";
 };
 

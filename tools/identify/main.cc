@@ -1,0 +1,199 @@
+// stewart_identify: the platform's mass properties (with its payload) from a
+// short excitation run of the stack, written as a config overlay
+// (docs/hardware.md, "Identify the platform and its payload").
+//
+//   stewart_identify --mode payload --plant sim --truth payload.yaml --out identified.yaml
+//   stewart_identify --mode payload --log runs/<run>/log.lcm --out identified.yaml
+#include <spdlog/spdlog.h>
+#include <sys/wait.h>
+
+#include <CLI/CLI.hpp>
+#include <cstdlib>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+
+#include "log_samples.h"
+#include "stewart/config/config_loader.h"
+#include "stewart/identify/inertial_fit.h"
+#include "stewart/identify/overlay_writer.h"
+#include "stewart/identify/platform_estimate.h"
+#include "stewart/node/exit_code.h"
+
+namespace fs = std::filesystem;
+using stewart::ExitCode;
+using stewart::ToInt;
+
+namespace {
+
+struct Options {
+  std::string mode;
+  std::string plant = "sim";
+  bool device_emulator = false;
+  std::string out_path;
+  std::string config_path;
+  std::vector<std::string> overlay_paths;
+  std::string truth_path;
+  std::string seed;
+  std::string scenario = "identify";
+  std::string duration_s;
+  std::string run_dir;
+  std::string lcm_url;
+  std::string log_path;
+  std::string state_source = "estimate";
+  double window_s = stewart::identify::InertialFitOptions{}.window_s;
+};
+
+std::string ShellQuote(const std::string& s) {
+  std::string quoted = "'";
+  for (const char ch : s) quoted += ch == '\'' ? std::string("'\\''") : std::string(1, ch);
+  return quoted + "'";
+}
+
+std::string Now(const char* format) {
+  const std::time_t t = std::time(nullptr);
+  char text[64];
+  std::strftime(text, sizeof text, format, std::localtime(&t));
+  return text;
+}
+
+// The excitation run: tools/launch.sh of the source tree this tool was built
+// from, on this build, recorded, without a report. Returns the run folder.
+std::string RunExcitation(const Options& o) {
+  const std::string run_dir = o.run_dir.empty() ? std::string(STEWART_SOURCE_DIR) + "/runs/" +
+                                                      Now("%Y%m%d-%H%M%S") + "-identify"
+                                                : fs::absolute(o.run_dir).string();
+  const char* build_env = std::getenv("STEWART_BUILD_DIR");
+  std::string command =
+      "cd " + ShellQuote(STEWART_SOURCE_DIR) +
+      " && STEWART_BUILD_DIR=" + ShellQuote(build_env ? build_env : STEWART_BUILD_DIR) +
+      " tools/launch.sh --no-build --no-report --plant " + ShellQuote(o.plant) + " --scenario " +
+      ShellQuote(o.scenario) + " --out " + ShellQuote(run_dir);
+  // The estimator must not assume the mass properties being identified
+  // (config/overlays/identify.yaml); the user's overlays come after it.
+  command += " --overlay " +
+             ShellQuote(std::string(STEWART_SOURCE_DIR) + "/config/overlays/identify.yaml");
+  for (const std::string& overlay : o.overlay_paths) {
+    command += " --overlay " + ShellQuote(fs::absolute(overlay).string());
+  }
+  if (!o.config_path.empty())
+    command += " --config " + ShellQuote(fs::absolute(o.config_path).string());
+  if (!o.truth_path.empty())
+    command += " --truth " + ShellQuote(fs::absolute(o.truth_path).string());
+  if (!o.seed.empty()) command += " --seed " + ShellQuote(o.seed);
+  if (!o.duration_s.empty()) command += " --duration " + ShellQuote(o.duration_s);
+  if (!o.lcm_url.empty()) command += " --lcm-url " + ShellQuote(o.lcm_url);
+  if (o.device_emulator) command += " --device-emulator";
+  spdlog::info("excitation: {}", command);
+  const int status = std::system(command.c_str());
+  const int code = status == -1 ? -1 : (WIFEXITED(status) ? WEXITSTATUS(status) : 128);
+  if (code != 0) {
+    throw stewart::identify::IdentificationError(
+        "the excitation run failed (tools/launch.sh exit " + std::to_string(code) +
+        "); its process logs are in " + run_dir);
+  }
+  return run_dir;
+}
+
+// The config the run used: the run folder's config.yaml (overlays merged),
+// unless --config names another.
+stewart::StackConfig RunConfig(const Options& o, const std::string& log_path) {
+  if (!o.config_path.empty()) return stewart::LoadStackConfig(o.config_path, o.overlay_paths);
+  const fs::path beside = fs::path(log_path).parent_path() / "config.yaml";
+  if (fs::exists(beside)) return stewart::LoadStackConfig(beside.string());
+  return stewart::LoadStackConfig(stewart::DefaultConfigPath(), o.overlay_paths);
+}
+
+int Identify(const Options& o) {
+  std::string log_path = o.log_path;
+  std::string provenance;
+  if (log_path.empty()) {
+    const std::string run_dir = RunExcitation(o);
+    log_path = run_dir + "/log.lcm";
+    provenance = "stewart_identify --mode payload --plant " + o.plant + ", scenario " + o.scenario +
+                 (o.truth_path.empty() ? "" : ", truth " + o.truth_path) + ", run " + run_dir;
+  } else {
+    provenance = "stewart_identify --mode payload on the log " + log_path;
+  }
+  const stewart::StackConfig config = RunConfig(o, log_path);
+  const std::string& state_channel = o.state_source == "truth" ? config.lcm.channels.state_truth
+                                                               : config.lcm.channels.state_estimate;
+  const stewart::identify::LogSamples log =
+      stewart::identify::ReadLogSamples(log_path, state_channel, config.lcm.channels.command_safe);
+  spdlog::info(
+      "{}: {} states on {} ({} unusable, {} without a recorded command), {} safe commands; {} "
+      "paired samples",
+      log_path, log.states, state_channel, log.unusable_states, log.unanswered_states, log.commands,
+      log.samples.size());
+  stewart::identify::InertialFitOptions fit_options;
+  fit_options.window_s = o.window_s;
+  const stewart::identify::InertialFit fit = stewart::identify::FitInertialParameters(
+      config.platform, config.actuators.viscous_friction_nspm, log.samples, fit_options);
+  const stewart::identify::PlatformEstimate estimate = stewart::identify::EstimatePlatform(fit);
+  provenance += "\nstate: " + state_channel + ", identified " + Now("%Y-%m-%d %H:%M") +
+                "\napply with: tools/launch.sh --overlay " + o.out_path;
+  const std::string overlay = stewart::identify::FormatPlatformOverlay(estimate, fit, provenance);
+  std::ofstream out(o.out_path);
+  out << overlay;
+  if (!out) {
+    spdlog::error("cannot write '{}'", o.out_path);
+    return ToInt(ExitCode::kFault);
+  }
+  spdlog::info("mass {:.4f} +- {:.2g} kg, CoM [{:.4f}, {:.4f}, {:.4f}] m; written to {}",
+               estimate.values(0), estimate.sigma(0), estimate.values(1), estimate.values(2),
+               estimate.values(3), o.out_path);
+  std::fputs(overlay.c_str(), stdout);
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Identify the platform's mass properties (with its payload) as a config overlay"};
+  Options o;
+  app.add_option("--mode", o.mode, "what to identify: payload (the platform body with its load)")
+      ->required()
+      ->check(CLI::IsMember({"payload"}));
+  app.add_option("--out", o.out_path, "overlay file to write")->required();
+  app.add_option("--plant", o.plant, "sim | hw (the excitation run's plant)")
+      ->check(CLI::IsMember({"sim", "hw"}))
+      ->capture_default_str();
+  app.add_flag("--device-emulator", o.device_emulator, "with --plant hw: the device emulator");
+  app.add_option("-c,--config", o.config_path, "stack config (default: config/platform.yaml)")
+      ->check(CLI::ExistingFile);
+  app.add_option("--overlay", o.overlay_paths, "config overlay (repeatable, applied in order)")
+      ->check(CLI::ExistingFile);
+  app.add_option("--truth", o.truth_path, "simulated plant's physics (sim or the emulator)")
+      ->check(CLI::ExistingFile);
+  app.add_option("--seed", o.seed, "sensor noise seed of the simulated plant");
+  app.add_option("--scenario", o.scenario, "excitation scenario, name or file")
+      ->capture_default_str();
+  app.add_option("--duration", o.duration_s, "seconds (default: the scenario's)");
+  app.add_option("--run-dir", o.run_dir, "run folder (default: runs/<date>-identify)");
+  app.add_option("--lcm-url", o.lcm_url, "LCM URL of the run (default: a private one)");
+  app.add_option("--log", o.log_path, "fit this recorded log instead of running the stack")
+      ->check(CLI::ExistingFile);
+  app.add_option("--state", o.state_source,
+                 "estimate (STATE_EST, as on the hardware) | truth (STATE_TRUE, simulation only)")
+      ->check(CLI::IsMember({"estimate", "truth"}))
+      ->capture_default_str();
+  app.add_option("--window", o.window_s, "integration window of the fit (s)")
+      ->check(CLI::Range(0.01, 5.0))
+      ->capture_default_str();
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    // --help exits 0 through CLI11; a bad flag is bad input, as for every node.
+    const int status = app.exit(e);
+    return status == 0 ? ToInt(ExitCode::kOk) : ToInt(ExitCode::kBadInput);
+  }
+  try {
+    return Identify(o);
+  } catch (const stewart::InputError& e) {
+    spdlog::error("{}", e.what());
+    return ToInt(ExitCode::kBadInput);
+  } catch (const std::exception& e) {
+    spdlog::error("stewart_identify: {}", e.what());
+    return ToInt(ExitCode::kFault);
+  }
+}
