@@ -5,10 +5,11 @@
 // input (one line, exit 2).
 //
 // The stack runs with the payload's mass and CoM as a rough prior (--overlay,
-// as if weighed and placed by hand): with the config's platform it cannot carry the payload, the
-// platform sinks onto its end stops and the tool refuses the run
-// (AnUnknownPayloadSinksOntoTheEndStops). The inertia stays the config's;
-// the fit never reads the prior (identify_test:
+// as if weighed and placed by hand), or with none: it estimates the payload
+// as part of the model error d. A stack that does not estimate d cannot carry
+// the payload: the platform sinks onto its end stops and the tool refuses the
+// run (AnUnknownPayloadSinksOntoTheEndStopsWithoutTheModelError). The
+// inertia stays the config's; the fit never reads the prior (identify_test:
 // FitIgnoresThePlatformBodyOfTheModel).
 #include <gtest/gtest.h>
 
@@ -113,23 +114,54 @@ TEST_F(IdentifyCli, RecoversAPayloadInSimulation) {
   EXPECT_LT(inertia_error, 0.05);
 
   // The run folder's config.yaml is what ran: the identification overlay
-  // (constant-velocity estimator) and the prior merged in.
+  // (the dynamics estimator with d) and the prior merged in.
   const StackConfig ran = LoadStackConfig(run_dir + "/config.yaml");
-  EXPECT_EQ(ran.estimator.process_model, EstimatorProcessModel::kConstantVelocity);
+  EXPECT_EQ(ran.estimator.process_model, EstimatorProcessModel::kDynamics);
+  EXPECT_TRUE(ran.estimator.estimate_disturbance);
   EXPECT_EQ(ran.platform.platform_mass_kg,
             YAML::LoadFile(prior_path)["platform"]["mass_kg"].as<double>());
   EXPECT_EQ(ran.platform.platform_inertia_kgm2, config.platform.platform_inertia_kgm2);
 }
 
-TEST_F(IdentifyCli, AnUnknownPayloadSinksOntoTheEndStops) {
-  // Without the prior the stack's model is 0.25 kg too light: the filter
-  // holds the commanded lift to what the model needs and the platform sinks
-  // onto its end stops, where the model does not hold. The tool says so.
+// No prior at all: the stack carries the unknown payload (estimated as part
+// of d) and the fit recovers it within the same bounds.
+TEST_F(IdentifyCli, RecoversAnUnknownPayloadWithoutAPrior) {
   const std::string truth_path = run_folder_ + "/payload.yaml";
   std::ofstream(truth_path) << kPayloadTruth;
+  const StackConfig config = LoadStackConfig(DefaultConfigPath());
+  const PlatformParams truth = LoadPlantTruth(config, truth_path).platform;
+  const std::string overlay_path = run_folder_ + "/identified.yaml";
   const int code = Identify("--mode payload --plant sim --truth " + ShellQuote(truth_path) +
-                            " --duration 8 --run-dir " + ShellQuote(run_folder_ + "/run") +
-                            " --lcm-url " + ShellQuote(PrivateLcmUrl(kNoPriorLcmPort)) + " --out " +
+                            " --seed 3 --run-dir " + ShellQuote(run_folder_ + "/run") +
+                            " --lcm-url " + ShellQuote(PrivateLcmUrl(kNoPriorLcmPort + 1)) +
+                            " --out " + ShellQuote(overlay_path));
+  ASSERT_EQ(code, 0) << ReadFile(Output());
+  const PlatformParams p = LoadStackConfig(DefaultConfigPath(), {overlay_path}).platform;
+  EXPECT_LT(std::abs(p.platform_mass_kg - truth.platform_mass_kg) / truth.platform_mass_kg, 0.02);
+  EXPECT_LT(
+      (p.platform_com_in_P_m - truth.platform_com_in_P_m).norm() / truth.platform_com_in_P_m.norm(),
+      0.05);
+  EXPECT_LT(
+      (PlatformInertiaInP(p) - PlatformInertiaInP(truth)).norm() / PlatformInertiaInP(truth).norm(),
+      0.05);
+}
+
+TEST_F(IdentifyCli, AnUnknownPayloadSinksOntoTheEndStopsWithoutTheModelError) {
+  // Without the prior and without estimating d, the stack's model is 0.25 kg
+  // too light: the filter holds the commanded lift to what the model needs
+  // and the platform sinks onto its end stops, where the model does not
+  // hold. The tool says so.
+  const std::string truth_path = run_folder_ + "/payload.yaml";
+  std::ofstream(truth_path) << kPayloadTruth;
+  const std::string no_d_path = run_folder_ + "/no_d.yaml";
+  std::ofstream(no_d_path)
+      << "estimator: {disturbance: {enabled: false}}\n"
+      << "controller: {compensate_disturbance: false}\n"
+      << "safety: {use_disturbance_estimate: false, velocity_rate_per_s: 1.0}\n";
+  const int code = Identify("--mode payload --plant sim --truth " + ShellQuote(truth_path) +
+                            " --overlay " + ShellQuote(no_d_path) + " --duration 8 --run-dir " +
+                            ShellQuote(run_folder_ + "/run") + " --lcm-url " +
+                            ShellQuote(PrivateLcmUrl(kNoPriorLcmPort)) + " --out " +
                             ShellQuote(run_folder_ + "/identified.yaml"));
   EXPECT_EQ(code, 2);
   EXPECT_NE(ReadFile(Output()).find("at a stroke end"), std::string::npos) << ReadFile(Output());
