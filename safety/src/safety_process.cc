@@ -64,13 +64,19 @@ bool SafetyProcess::OnState(const StateSample& state, SafetyOutput* out) {
     *out = Fallback(state, kCommandInvalidInput);
     return true;
   }
-  if (pending_for_this) {
-    *out = Filter(state, pending_nominal_);
-    return true;
-  }
-  if (state.utime - newest_nominal_sample_utime_ > stale_age_us_) {
+  // Judged on the nominals derived from earlier samples only: whether this
+  // sample's own nominal overtook the state (multicast order) must not change
+  // the answer, so a log or an in-process run replays the same commands.
+  const int64_t newest_earlier_nominal =
+      pending_for_this ? newest_nominal_before_pending_ : newest_nominal_sample_utime_;
+  if (state.utime - newest_earlier_nominal > stale_age_us_) {
     if (state.sample_utime <= last_published_sample_utime_) return false;
     *out = Fallback(state, kCommandStaleInput);
+    if (pending_for_this) counters_->Reject("nominal_already_answered");
+    return true;
+  }
+  if (pending_for_this) {
+    *out = Filter(state, pending_nominal_);
     return true;
   }
   return false;
@@ -80,6 +86,7 @@ bool SafetyProcess::OnNominal(const ForceCommand& nominal, SafetyOutput* out) {
   counters_->CountIn();
   // A command that arrives, even one answered already by a fallback, shows
   // the controller is alive.
+  const int64_t newest_nominal_before = newest_nominal_sample_utime_;
   newest_nominal_sample_utime_ = std::max(newest_nominal_sample_utime_, nominal.sample_utime);
   if (nominal.sample_utime <= last_published_sample_utime_) {
     counters_->Reject("nominal_already_answered");  // a fallback went out for it
@@ -93,6 +100,7 @@ bool SafetyProcess::OnNominal(const ForceCommand& nominal, SafetyOutput* out) {
       // that state arrives (OnState), never filtered against another state.
       pending_nominal_ = nominal;
       has_pending_nominal_ = true;
+      newest_nominal_before_pending_ = newest_nominal_before;
       counters_->Count("nominal_before_state");
       return false;
     }

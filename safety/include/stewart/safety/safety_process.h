@@ -74,6 +74,8 @@ class SafetyProcess {
   // A nominal command that arrived before its state (see OnNominal).
   ForceCommand pending_nominal_{};
   bool has_pending_nominal_ = false;
+  /// newest_nominal_sample_utime_ before the pending nominal arrived.
+  int64_t newest_nominal_before_pending_ = -1;
   int64_t seq_ = 0;
   SafetyDiagnostics diagnostics_{};
 };

@@ -1,0 +1,78 @@
+// The safety process answers the same commands whatever the order in which
+// a state and the nominal command derived from it arrive (multicast from two
+// senders is not ordered), so an in-process run, a live run over LCM and a
+// replay agree bit for bit.
+#include <gtest/gtest.h>
+
+#include <vector>
+
+#include "safety_test_support.h"
+#include "stewart/common/health_counters.h"
+#include "stewart/safety/safety_process.h"
+
+namespace stewart::safety::test {
+namespace {
+
+struct Answer {
+  int64_t sample_utime;
+  Vector6d force_n;
+  int32_t flags;
+};
+
+// Steps `samples` states from start-up, each with its nominal command, in
+// the order given per sample (true: nominal first), and returns every answer.
+std::vector<Answer> Answers(const std::vector<bool>& nominal_first) {
+  const StackConfig& c = DefaultConfig();
+  HealthCounters counters("safety order test");
+  SafetyProcess process(c.platform, c.safety, c.actuators, nullptr, &counters);
+  const Vector6d q = c.home_pose;
+  const Vector6d f_des = HoverForce(q) + Vector6d::Constant(0.5);
+  std::vector<Answer> answers;
+  for (size_t k = 0; k < nominal_first.size(); ++k) {
+    StateSample state;
+    state.utime = state.sample_utime = 1'000'000 + 1000 * static_cast<int64_t>(k);
+    state.seq = static_cast<int64_t>(k);
+    state.q = q;
+    state.status = kStateValid;
+    ForceCommand nominal;
+    nominal.utime = nominal.sample_utime = state.sample_utime;
+    nominal.seq = static_cast<int64_t>(k);
+    nominal.force_n = f_des;
+    SafetyOutput out;
+    const auto keep = [&](bool answered) {
+      if (answered)
+        answers.push_back({out.command.sample_utime, out.command.force_n, out.command.flags});
+    };
+    if (nominal_first[k]) {
+      keep(process.OnNominal(nominal, &out));
+      keep(process.OnState(state, &out));
+    } else {
+      keep(process.OnState(state, &out));
+      keep(process.OnNominal(nominal, &out));
+    }
+  }
+  return answers;
+}
+
+TEST(SafetyProcessOrder, StateOrNominalFirstGiveTheSameCommands) {
+  const std::vector<bool> state_first(6, false);
+  const std::vector<bool> nominal_first(6, true);
+  const std::vector<bool> mixed = {true, false, true, true, false, true};
+  const std::vector<Answer> reference = Answers(state_first);
+  ASSERT_EQ(reference.size(), 6u);  // one answer per sample
+  // The first sample has no earlier nominal: the fallback, in every order.
+  EXPECT_TRUE(reference[0].flags & kCommandFallback);
+  EXPECT_FALSE(reference[1].flags & kCommandFallback);
+  for (const auto& order : {nominal_first, mixed}) {
+    const std::vector<Answer> answers = Answers(order);
+    ASSERT_EQ(answers.size(), reference.size());
+    for (size_t i = 0; i < answers.size(); ++i) {
+      EXPECT_EQ(answers[i].sample_utime, reference[i].sample_utime) << i;
+      EXPECT_EQ(answers[i].force_n, reference[i].force_n) << i;
+      EXPECT_EQ(answers[i].flags, reference[i].flags) << i;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace stewart::safety::test
