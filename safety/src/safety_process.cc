@@ -67,9 +67,13 @@ bool SafetyProcess::OnState(const StateSample& state, SafetyOutput* out) {
   // Judged on the nominals derived from earlier samples only: whether this
   // sample's own nominal overtook the state (multicast order) must not change
   // the answer, so a log or an in-process run replays the same commands.
+  // Until the first nominal, the watchdog counts from the first usable
+  // state: the controller gets stale_age_s to answer it, however late its
+  // answer arrives relative to the next states.
+  if (first_usable_state_utime_ < 0) first_usable_state_utime_ = state.utime;
   const int64_t newest_earlier_nominal =
       pending_for_this ? newest_nominal_before_pending_ : newest_nominal_sample_utime_;
-  if (state.utime - newest_earlier_nominal > stale_age_us_) {
+  if (state.utime - std::max(newest_earlier_nominal, first_usable_state_utime_) > stale_age_us_) {
     if (state.sample_utime <= last_published_sample_utime_) return false;
     *out = Fallback(state, kCommandStaleInput);
     if (pending_for_this) counters_->Reject("nominal_already_answered");

@@ -60,8 +60,9 @@ TEST(SafetyProcessOrder, StateOrNominalFirstGiveTheSameCommands) {
   const std::vector<bool> mixed = {true, false, true, true, false, true};
   const std::vector<Answer> reference = Answers(state_first);
   ASSERT_EQ(reference.size(), 6u);  // one answer per sample
-  // The first sample has no earlier nominal: the fallback, in every order.
-  EXPECT_TRUE(reference[0].flags & kCommandFallback);
+  // The first usable state gives the controller stale_age_s to answer: its
+  // nominal is filtered, in every order.
+  EXPECT_FALSE(reference[0].flags & kCommandFallback);
   EXPECT_FALSE(reference[1].flags & kCommandFallback);
   for (const auto& order : {nominal_first, mixed}) {
     const std::vector<Answer> answers = Answers(order);
