@@ -2,10 +2,11 @@
 #include <cmath>
 
 #include "stewart/config/sections.h"
+#include "stewart/model/dc_motor.h"
 
 namespace stewart {
 
-HwBridgeConfig ParseHwBridgeConfig(const ConfigNode& hw_bridge) {
+HwBridgeConfig ParseHwBridgeConfig(const ConfigNode& hw_bridge, const ActuatorConfig& actuators) {
   HwBridgeConfig h;
   h.transport = hw_bridge.Choice("transport", {"udp", "serial"});
   h.device_host = hw_bridge.String("device_host");
@@ -51,9 +52,20 @@ HwBridgeConfig ParseHwBridgeConfig(const ConfigNode& hw_bridge) {
   h.gyro_radps_per_lsb = hw_bridge.PositiveDouble("gyro_radps_per_lsb");
   h.accel_mps2_per_lsb = hw_bridge.PositiveDouble("accel_mps2_per_lsb");
 
-  h.force_at_full_duty_n = hw_bridge.PositiveDouble("force_at_full_duty_n");
-  h.duty_deadband = hw_bridge.NonNegativeDouble("duty_deadband");
-  if (h.duty_deadband >= 1.0) hw_bridge.Fail("duty_deadband", "must be < 1");
+  if (actuators.kind == ActuatorKind::kDcMotor) {
+    // One source for the motor's input map: actuators.motor.
+    for (const char* key : {"force_at_full_duty_n", "duty_deadband"}) {
+      if (hw_bridge.Has(key)) {
+        hw_bridge.Fail(key, "is set by actuators.motor when actuators.model is dc_motor");
+      }
+    }
+    h.force_at_full_duty_n = DcMotorForceAtFullDuty(actuators.motor);
+    h.duty_deadband = actuators.motor.dead_band_duty;
+  } else {
+    h.force_at_full_duty_n = hw_bridge.PositiveDouble("force_at_full_duty_n");
+    h.duty_deadband = hw_bridge.NonNegativeDouble("duty_deadband");
+    if (h.duty_deadband >= 1.0) hw_bridge.Fail("duty_deadband", "must be < 1");
+  }
   h.force_deadzone_n = hw_bridge.NonNegativeDouble("force_deadzone_n");
   h.max_duty = hw_bridge.PositiveDouble("max_duty");
   if (h.max_duty > 1.0) hw_bridge.Fail("max_duty", "must be <= 1");

@@ -1,6 +1,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "stewart/config/sections.h"
+#include "stewart/model/dc_motor.h"
 
 namespace stewart {
 
@@ -48,6 +49,10 @@ PlatformParams ParsePlatformParams(const ConfigNode& root) {
   p.leg.rod_com_from_platform_m = legs.NonNegativeDouble("rod_com_from_platform_m");
   p.leg.rod_inertia_kgm2 = legs.NonNegativeDouble("rod_inertia_kgm2");
 
+  const ActuatorConfig actuator_config = ParseActuatorConfig(actuators);
+  if (actuator_config.kind == ActuatorKind::kDcMotor) {
+    p.leg.actuator_reflected_mass_kg = actuator_config.motor.reflected_mass_kg;
+  }
   p.leg_min_length_m = actuators.PositiveDouble("min_length_m");
   p.leg_max_length_m = p.leg_min_length_m + actuators.PositiveDouble("stroke_m");
   if (p.leg.rod_com_from_platform_m >= p.leg_min_length_m) {
@@ -56,11 +61,49 @@ PlatformParams ParsePlatformParams(const ConfigNode& root) {
   return p;
 }
 
+namespace {
+
+DcMotorParams ParseDcMotorParams(const ConfigNode& motor) {
+  DcMotorParams m;
+  m.supply_voltage_v = motor.PositiveDouble("supply_voltage_v");
+  m.bridge_drop_v = motor.NonNegativeDouble("bridge_drop_v");
+  if (!(m.bridge_drop_v < m.supply_voltage_v)) {
+    motor.Fail("bridge_drop_v", "must be below supply_voltage_v");
+  }
+  m.dead_band_duty = motor.NonNegativeDouble("dead_band_duty");
+  if (!(m.dead_band_duty < 1.0)) motor.Fail("dead_band_duty", "must be < 1");
+  m.rated_voltage_v = motor.PositiveDouble("rated_voltage_v");
+  m.stall_force_n = motor.PositiveDouble("stall_force_n");
+  m.no_load_speed_mps = motor.PositiveDouble("no_load_speed_mps");
+  m.reflected_mass_kg = motor.NonNegativeDouble("reflected_mass_kg");
+  m.coulomb_friction_n = motor.NonNegativeDouble("coulomb_friction_n");
+  m.back_drive_force_n = motor.NonNegativeDouble("back_drive_force_n");
+  m.lock_stiffness_npm = motor.PositiveDouble("lock_stiffness_npm");
+  return m;
+}
+
+}  // namespace
+
 ActuatorConfig ParseActuatorConfig(const ConfigNode& actuators) {
   ActuatorConfig a;
+  // Optional: configs written for the ideal force source have no `model`.
+  if (actuators.Has("model")) {
+    a.kind = actuators.Choice("model", {"ideal_force", "dc_motor"}) == "dc_motor"
+                 ? ActuatorKind::kDcMotor
+                 : ActuatorKind::kIdealForce;
+  }
+  // Checked whenever present (an overlay may switch the model to it).
+  if (a.kind == ActuatorKind::kDcMotor || actuators.Has("motor")) {
+    a.motor = ParseDcMotorParams(actuators.Child("motor"));
+  }
   a.min_length_m = actuators.PositiveDouble("min_length_m");
   a.stroke_m = actuators.PositiveDouble("stroke_m");
   a.force_limit_n = actuators.PositiveDouble("force_limit_n");
+  if (a.kind == ActuatorKind::kDcMotor && a.force_limit_n > DcMotorForceAtFullDuty(a.motor)) {
+    actuators.Fail("force_limit_n", "exceeds the motor's force at full duty (" +
+                                        std::to_string(DcMotorForceAtFullDuty(a.motor)) +
+                                        " N from actuators.motor)");
+  }
   a.viscous_friction_nspm = actuators.NonNegativeDouble("viscous_friction_nspm");
   a.force_lag_s = actuators.NonNegativeDouble("force_lag_s");
   a.endstop_stiffness_npm = actuators.PositiveDouble("endstop_stiffness_npm");

@@ -5,6 +5,7 @@
 
 #include "stewart/config/config_loader.h"
 #include "stewart/config/sections.h"
+#include "stewart/model/dc_motor.h"
 #include "stewart/model/kinematics.h"
 
 namespace stewart {
@@ -41,14 +42,14 @@ StackConfig ParseRoot(const YAML::Node& yaml, const std::string& source) {
   c.safety = ParseSafetyConfig(root.Child("safety"));
   c.estimator = ParseEstimatorConfig(root.Child("estimator"));
   c.plant_sim = ParsePlantSimConfig(root.Child("plant_sim"));
-  c.hw_bridge = ParseHwBridgeConfig(root.Child("hw_bridge"));
+  c.hw_bridge = ParseHwBridgeConfig(root.Child("hw_bridge"), c.actuators);
   c.lcm = ParseLcmConfig(root.Child("lcm"), root.Child("rates"));
-  // One friction coefficient, the actuators': the controller and the filter
-  // model what the plant has (or nothing, when told not to).
-  c.controller.leg_friction_nspm =
-      c.controller.compensate_friction ? c.actuators.viscous_friction_nspm : 0.0;
-  c.safety.leg_friction_nspm =
-      c.safety.model_leg_friction ? c.actuators.viscous_friction_nspm : 0.0;
+  // One leg damping, the actuators' (screw friction and, for a DC motor, its
+  // back-EMF): the controller and the filter model what the plant has (or
+  // nothing, when told not to).
+  const double leg_damping_nspm = ModelLegDampingNspm(c.actuators);
+  c.controller.leg_friction_nspm = c.controller.compensate_friction ? leg_damping_nspm : 0.0;
+  c.safety.leg_friction_nspm = c.safety.model_leg_friction ? leg_damping_nspm : 0.0;
   ValidateStackConfig(c);
   return c;
 }

@@ -50,6 +50,14 @@ Vector6d DriveMap::DriveToForce(const DriveArray& drive) const {
   return force;
 }
 
+Vector6d DriveMap::Duty(const DriveArray& drive) const {
+  Vector6d duty;
+  for (int i = 0; i < kNumLegs; ++i) {
+    duty(i) = drive_sign_(i) * drive[static_cast<std::size_t>(i)] / kDriveFullScale;
+  }
+  return duty;
+}
+
 std::array<bool, 6> DriveMap::Locked(const DriveArray& drive) const {
   std::array<bool, 6> locked{};
   for (std::size_t i = 0; i < 6; ++i) {

@@ -19,11 +19,12 @@ using internal::SumOfOuterProducts;
 //  - cylinder translation and both transverse rotations, 1/2 mu |nd|^2 with
 //    mu = m1 e1^2 + I1 + I2: the kinetic energy of a point of mass mu at the
 //    unit vector n_i;
-//  - rod translation, 1/2 m2 |d/dt (a_i - e2 n_i)|^2.
+//  - rod translation, 1/2 m2 |d/dt (a_i - e2 n_i)|^2;
+//  - the actuator's rotor, 1/2 m_r Ld^2 with Ld = n . v (reflected mass).
 // With v = J_a qd the joint velocity and J_a = [I, -[p]x E] (p = R p_i, {B}),
 // both give a 3x3 "joint-space" inertia at a_i (kg),
-//   A = m2 n n^T + c (I - n n^T) = c I + d n n^T,
-//   c = mu / L^2 + m2 s^2,  d = m2 - c,  s = 1 - e2 / L,
+//   A = (m2 + m_r) n n^T + c (I - n n^T) = c I + d n n^T,
+//   c = mu / L^2 + m2 s^2,  d = m2 + m_r - c,  s = 1 - e2 / L,
 // and joint-space bias and gravity forces (N), mapped through J_a^T
 // (docs/model.md, "Dynamics"). A is rank one in n, so no 3x3 product is needed.
 struct LegJointTerms {
@@ -40,11 +41,13 @@ struct LegMassConstants {
            leg.cylinder_inertia_kgm2 + leg.rod_inertia_kgm2),
         m2(leg.rod_mass_kg),
         e2(leg.rod_com_from_platform_m),
-        m1_e1(leg.cylinder_mass_kg * leg.cylinder_com_from_base_m) {}
+        m1_e1(leg.cylinder_mass_kg * leg.cylinder_com_from_base_m),
+        m_r(leg.actuator_reflected_mass_kg) {}
   double mu;     // kg m^2
   double m2;     // kg
   double e2;     // m
   double m1_e1;  // kg m
+  double m_r;    // kg
 };
 
 // n: unit leg vectors, inv_l = 1/L (1/m), v and a_bias: velocity (m/s) and
@@ -57,13 +60,18 @@ LegJointTerms ComputeLegJointTerms(const LegMassConstants& k, double g, const Le
   const LegScalars s = 1.0 - k.e2 * inv_l;
   LegJointTerms out;
   out.c = k.mu * inv_l.square() + k.m2 * s.square();
-  out.d = k.m2 - out.c;
+  out.d = k.m2 + k.m_r - out.c;
   const LegScalars ld = Dot(n, v);                                 // leg speed (m/s)
   const LegVectors nd = (v - n.rowwise() * ld).rowwise() * inv_l;  // (I - n n^T) v / L (1/s)
   // With ndd|qdd=0 = [(I - n n^T) a_bias - 2 Ld nd] / L - n |nd|^2 the two
   // terms mu J_n^T ndd + m2 J_r^T (a_bias - e2 ndd) collect into
   //   f_bias = A a_bias + m2 e2 |nd|^2 n + 2 Ld (m2 s e2 / L - mu / L^2) nd.
-  const LegScalars along_n = out.d * Dot(n, a_bias) + k.m2 * k.e2 * nd.square().colwise().sum();
+  // The rotor adds m_r Ldd|qdd=0 n = m_r (n . a_bias + L |nd|^2) n (its
+  // Lagrangian term is m_r Ldd J_l^T: the velocity terms cancel), whose first
+  // part is in A a_bias.
+  const LegScalars nd_sq = nd.square().colwise().sum();
+  const LegScalars along_n =
+      out.d * Dot(n, a_bias) + (k.m2 * k.e2 + k.m_r / inv_l) * nd_sq;
   const LegScalars along_nd = 2.0 * ld * inv_l * (k.m2 * k.e2 * s - k.mu * inv_l);
   out.f_bias = a_bias.rowwise() * out.c + n.rowwise() * along_n + nd.rowwise() * along_nd;
   // V = g (m1 e1 n_z + m2 (a - e2 n)_z):

@@ -33,7 +33,7 @@ PlantSimNode::PlantSimNode(const StackConfig& config, const PlantTruth& truth, l
       options_(options),
       lcm_(lcm),
       receiver_(config.lcm.url),
-      plant_(PlantModelOf(truth), OdeOptionsFrom(config.plant_sim)),
+      plant_(PlantModelOf(truth, config), OdeOptionsFrom(config.plant_sim)),
       sensors_(truth.sensors, truth.actuators, truth.platform.gravity_mps2, truth.sensor_errors),
       disturbance_(truth.disturbance, truth.sensors.seed),
       health_("plant_sim", config.lcm.channels.health, config.lcm.health_rate_hz),

@@ -1,6 +1,11 @@
 #include "stewart/plant_sim/actuator_model.h"
 
+#include <algorithm>
+#include <cmath>
+
+#include "stewart/model/dc_motor.h"
 #include "stewart/model/dynamics.h"
+#include "stewart/plant_sim/plant_dynamics.h"
 
 namespace stewart {
 
@@ -52,6 +57,41 @@ Vector6d LegLockForce(const ActuatorConfig& actuators, const Vector6d& leg_lengt
                       const Vector6d& leg_speed_mps, const Vector6d& lock_length_m) {
   return -actuators.endstop_stiffness_npm * (leg_length_m - lock_length_m) -
          actuators.endstop_damping_nspm * leg_speed_mps;
+}
+
+Vector6d DcMotorDriveForce(const DcMotorParams& motor, const Vector6d& duty, bool power_off) {
+  Vector6d force = Vector6d::Zero();
+  if (power_off) return force;
+  for (int i = 0; i < kNumLegs; ++i) force(i) = DcMotorDriveForce(motor, duty(i));
+  return force;
+}
+
+bool DcMotorEnergised(const DcMotorParams& motor, double duty, bool power_off) {
+  return !power_off && DcMotorEffectiveDuty(motor, duty) != 0.0;
+}
+
+double DcMotorHoldDampingNspm(const DcMotorParams& motor) {
+  return 2.0 * std::sqrt(motor.lock_stiffness_npm * std::max(motor.reflected_mass_kg, 0.1));
+}
+
+Vector6d DcMotorLegForce(const ActuatorConfig& actuators, const PlantInputs& inputs,
+                         const Vector6d& leg_length_m, const Vector6d& leg_speed_mps) {
+  const DcMotorParams& motor = actuators.motor;
+  const double b_emf = inputs.legs_locked ? 0.0 : DcMotorBackEmfDampingNspm(motor);
+  const double c_hold = DcMotorHoldDampingNspm(motor);
+  Vector6d force;
+  for (int i = 0; i < kNumLegs; ++i) {
+    const double ld = leg_speed_mps(i);
+    const double dry = DcMotorEnergised(motor, inputs.duty(i), inputs.legs_locked)
+                           ? motor.coulomb_friction_n
+                           : motor.back_drive_force_n;
+    force(i) = -b_emf * ld - dry * std::tanh(ld / kCoulombSpeedScaleMps);
+    if (inputs.leg_held[static_cast<std::size_t>(i)]) {
+      force(i) += -motor.lock_stiffness_npm * (leg_length_m(i) - inputs.hold_length_m(i)) -
+                  c_hold * ld;
+    }
+  }
+  return force;
 }
 
 Vector6d ForceLagRate(const ActuatorConfig& actuators, const Vector6d& force_sat_n,

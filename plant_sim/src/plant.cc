@@ -1,6 +1,7 @@
 #include "stewart/plant_sim/plant.h"
 
 #include <array>
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
@@ -21,6 +22,11 @@ constexpr int kMaxRootStopsPerAdvance = 10000;
 // constants to every vector operation and to the error norm.
 constexpr int kMotionStateSize = 12;
 
+// DC motor: a leg slower than this with its motor not energised is taken
+// hold of by its self-locking screw (m/s; a tenth of the dry friction's
+// smoothing speed, so the friction is nearly at full strength there).
+constexpr double kHoldSpeedMps = 1e-4;
+
 int OdeSizeFor(const ActuatorConfig& actuators) {
   return actuators.force_lag_s > 0.0 ? kPlantStateSize : kMotionStateSize;
 }
@@ -40,23 +46,39 @@ void Plant::Reset(double t_s, const Vector6d& q, const Vector6d& qd) {
   x_.segment<6>(6) = qd;
   inputs_ = PlantInputs{};
   endstop_hits_ = 0;
+  self_lock_engagements_ = 0;
   delayed_head_ = delayed_count_ = 0;
   MarkDiscontinuity();
 }
 
 void Plant::SetForceCommand(const Vector6d& force_cmd_n) {
+  QueueCommand(model_.actuators.kind == ActuatorKind::kDcMotor
+                   ? DutyForForce(model_.duty_map, force_cmd_n)
+                   : force_cmd_n);
+}
+
+void Plant::SetDutyCommand(const Vector6d& duty) {
+  if (model_.actuators.kind != ActuatorKind::kDcMotor) {
+    throw std::logic_error("Plant::SetDutyCommand: the actuators are not DC motors");
+  }
+  QueueCommand(duty.unaryExpr([](double d) { return std::isfinite(d) ? d : 0.0; })
+                   .cwiseMax(-1.0)
+                   .cwiseMin(1.0));
+}
+
+void Plant::QueueCommand(const Vector6d& command) {
   if (!(model_.command_delay_s > 0.0)) {
-    ApplyForceCommand(force_cmd_n);
+    ApplyCommand(command);
     return;
   }
   if (delayed_count_ == kDelayCapacity) {
-    ApplyForceCommand(delayed_[static_cast<size_t>(delayed_head_)].force_cmd_n);
+    ApplyCommand(delayed_[static_cast<size_t>(delayed_head_)].command);
     delayed_head_ = (delayed_head_ + 1) % kDelayCapacity;
     --delayed_count_;
     ++delayed_dropped_;
   }
   const int tail = (delayed_head_ + delayed_count_) % kDelayCapacity;
-  delayed_[static_cast<size_t>(tail)] = DelayedCommand{t_s_ + model_.command_delay_s, force_cmd_n};
+  delayed_[static_cast<size_t>(tail)] = DelayedCommand{t_s_ + model_.command_delay_s, command};
   ++delayed_count_;
 }
 
@@ -66,15 +88,50 @@ void Plant::SetExternalWrench(const Vector6d& wrench) {
   MarkDiscontinuity();
 }
 
-void Plant::ApplyForceCommand(const Vector6d& force_cmd_n) {
-  if (force_cmd_n == inputs_.force_cmd_n) return;
-  inputs_.force_cmd_n = force_cmd_n;
+void Plant::ApplyCommand(const Vector6d& command) {
+  const bool dc_motor = model_.actuators.kind == ActuatorKind::kDcMotor;
+  Vector6d& held = dc_motor ? inputs_.duty : inputs_.force_cmd_n;
+  if (command == held) return;
+  held = command;
   if (!(model_.actuators.force_lag_s > 0.0)) {
     // Without lag the motor force is the saturated command; the state keeps it for output.
     x_.segment<6>(12) = model_.actuator_errors.force_gain.cwiseProduct(
-        SaturateForce(model_.actuators, force_cmd_n));
+        dc_motor ? DcMotorDriveForce(model_.actuators.motor, command, inputs_.legs_locked)
+                 : SaturateForce(model_.actuators, command));
   }
   MarkDiscontinuity();
+}
+
+void Plant::UpdateSelfLocking() {
+  if (model_.actuators.kind != ActuatorKind::kDcMotor) return;
+  const DcMotorParams& motor = model_.actuators.motor;
+  const PlantRates& rates = EvaluateRates();
+  const Vector6d leg_speed_mps = rates.terms.H.transpose() * qd();
+  const Vector6d& leg_length_m = rates.terms.leg_length_m;
+  const double c_hold = DcMotorHoldDampingNspm(motor);
+  bool changed = false;
+  for (int i = 0; i < kNumLegs; ++i) {
+    bool& held = inputs_.leg_held[static_cast<size_t>(i)];
+    const bool energised = DcMotorEnergised(motor, inputs_.duty(i), inputs_.legs_locked);
+    bool hold = held;
+    if (energised) {
+      hold = false;
+    } else if (held) {
+      const double spring_n = motor.lock_stiffness_npm *
+                                  (leg_length_m(i) - inputs_.hold_length_m(i)) +
+                              c_hold * leg_speed_mps(i);
+      hold = std::abs(spring_n) <= motor.back_drive_force_n;
+    } else if (std::abs(leg_speed_mps(i)) < kHoldSpeedMps) {
+      hold = true;
+      inputs_.hold_length_m(i) = leg_length_m(i);
+      ++self_lock_engagements_;
+    }
+    if (hold != held) {
+      held = hold;
+      changed = true;
+    }
+  }
+  if (changed) MarkDiscontinuity();
 }
 
 void Plant::SetActuatorsOff(bool off) {
@@ -83,7 +140,7 @@ void Plant::SetActuatorsOff(bool off) {
   if (off) {
     inputs_.lock_length_m = InverseKinematics(model_.platform, q());
     delayed_head_ = delayed_count_ = 0;
-    ApplyForceCommand(Vector6d::Zero());
+    ApplyCommand(Vector6d::Zero());
   }
   MarkDiscontinuity();
 }
@@ -94,7 +151,7 @@ void Plant::Advance(double dt_s) {
   while (delayed_count_ > 0 && delayed_[static_cast<size_t>(delayed_head_)].apply_s < t_end) {
     const DelayedCommand& next = delayed_[static_cast<size_t>(delayed_head_)];
     if (next.apply_s > t_s_) IntegrateTo(next.apply_s);
-    ApplyForceCommand(next.force_cmd_n);
+    ApplyCommand(next.command);
     delayed_head_ = (delayed_head_ + 1) % kDelayCapacity;
     --delayed_count_;
   }
@@ -102,6 +159,7 @@ void Plant::Advance(double dt_s) {
 }
 
 void Plant::IntegrateTo(double t_end) {
+  UpdateSelfLocking();
   const double t_start = t_s_;
   const PlantStateVector x_start = x_;
   const long hits_start = endstop_hits_;
@@ -181,6 +239,7 @@ PlantCounters Plant::counters() const {
   c.endstop_hits = endstop_hits_;
   c.delayed_commands_dropped = delayed_dropped_;
   c.stiff_fallbacks = stiff_fallbacks_;
+  c.self_lock_engagements = self_lock_engagements_;
   c.ode = integrator_.stats();
   return c;
 }

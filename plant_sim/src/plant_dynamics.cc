@@ -18,8 +18,10 @@ void PlantDerivativeGivenTerms(const PlantModel& model, const PlantInputs& input
   const Vector6d leg_speed_mps = terms.H.transpose() * qd;  // Ld = J_l qd, H = J_l^T
 
   const ActuatorConfig& act = model.actuators;
-  const Vector6d force_sat_n =
-      model.actuator_errors.force_gain.cwiseProduct(SaturateForce(act, inputs.force_cmd_n));
+  const bool dc_motor = act.kind == ActuatorKind::kDcMotor;
+  const Vector6d force_sat_n = model.actuator_errors.force_gain.cwiseProduct(
+      dc_motor ? DcMotorDriveForce(act.motor, inputs.duty, inputs.legs_locked)
+               : SaturateForce(act, inputs.force_cmd_n));
   Vector6d force_motor_n;
   Vector6d force_motor_rate = Vector6d::Zero();
   if (act.force_lag_s > 0.0) {
@@ -34,7 +36,9 @@ void PlantDerivativeGivenTerms(const PlantModel& model, const PlantInputs& input
   if (!model.actuator_errors.coulomb_friction_n.isZero()) {
     leg_force_n += CoulombFrictionForce(model.actuator_errors.coulomb_friction_n, leg_speed_mps);
   }
-  if (inputs.legs_locked) {
+  if (dc_motor) {
+    leg_force_n += DcMotorLegForce(act, inputs, leg_length_m, leg_speed_mps);
+  } else if (inputs.legs_locked) {
     leg_force_n += LegLockForce(act, leg_length_m, leg_speed_mps, inputs.lock_length_m);
   }
   rates->leg_force_n = leg_force_n;
@@ -46,6 +50,16 @@ void PlantDerivativeGivenTerms(const PlantModel& model, const PlantInputs& input
         terms, leg_force_n, GeneralisedForceOfWrench(PoseOf(x), inputs.external_wrench));
   }
   rates->x_dot.segment<6>(12) = force_motor_rate;
+}
+
+ForceToDutyMap PlantModel::DriverOf(const ActuatorConfig& actuators) {
+  ForceToDutyMap map;
+  map.force_limit_n = actuators.force_limit_n;
+  if (actuators.kind == ActuatorKind::kDcMotor) {
+    map.force_at_full_duty_n = DcMotorForceAtFullDuty(actuators.motor);
+    map.dead_band_duty = actuators.motor.dead_band_duty;
+  }
+  return map;
 }
 
 double PlantMechanicalEnergy(const PlantModel& model, const Vector6d& q, const Vector6d& qd) {

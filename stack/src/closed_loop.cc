@@ -72,7 +72,7 @@ ClosedLoopSummary RunClosedLoop(const StackConfig& config, const Scenario& scena
   PlantTruth truth = options.truth ? *options.truth : TruthOfConfig(config);
   truth.sensors.seed = sensors.seed;
   truth.sensors.rate_hz = sensors.rate_hz;
-  Plant plant(PlantModelOf(truth), OdeOptionsFrom(config.plant_sim));
+  Plant plant(PlantModelOf(truth, config), OdeOptionsFrom(config.plant_sim));
   plant.Reset(0.0, truth.initial_pose, truth.initial_velocity);
   SensorModel sensor_model(truth.sensors, truth.actuators, truth.platform.gravity_mps2,
                            truth.sensor_errors);

@@ -166,7 +166,7 @@ drive_sign: [1, 1, 1, 1, 1, 1]
 )"),
                         "hw_bridge");
   try {
-    ParseHwBridgeConfig(good);
+    ParseHwBridgeConfig(good, ActuatorConfig{});
     FAIL() << "degenerate calibration span accepted";
   } catch (const ConfigError& e) {
     EXPECT_EQ(e.key(), "hw_bridge.adc_extended");

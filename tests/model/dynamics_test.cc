@@ -4,6 +4,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <random>
+#include <vector>
 
 #include "test_states.h"
 
@@ -61,8 +62,15 @@ Matrix6d MassMatrixRate(const PlatformParams& p, const Vector6d& q, const Vector
 
 // qd^T (Mdot - 2C) qd = 0, Mdot by central differences along qd. The
 // energy-based CBF's derivative is only right if this holds.
+// Also with the DC-motor legs' rotor inertia (80 kg reflected per leg).
+std::vector<PlatformParams> ModelsUnderTest() {
+  PlatformParams with_rotors = DefaultConfig().platform;
+  with_rotors.leg.actuator_reflected_mass_kg = 80.0;
+  return {DefaultConfig().platform, with_rotors};
+}
+
 TEST(Dynamics, PowerBalance) {
-  const auto& p = DefaultConfig().platform;
+  for (const PlatformParams& p : ModelsUnderTest()) {
   ForRandomPoses(12, kStates, [&](const Vector6d& q, std::mt19937* rng) {
     const Vector6d qd = RandomVelocity(rng);
     const Matrix6d Mdot = MassMatrixRate(p, q, qd);
@@ -70,12 +78,13 @@ TEST(Dynamics, PowerBalance) {
     const double scale = std::abs(qd.dot(Mdot * qd)) + 2 * std::abs(qd.dot(t.C_qd)) + 1e-12;
     EXPECT_LT(std::abs(qd.dot(Mdot * qd) - 2.0 * qd.dot(t.C_qd)) / scale, 1e-7);
   });
+  }
 }
 
 // The whole vector, not only its power: C qd = Mdot qd - 1/2 d/dq (qd^T M qd)
 // (Lagrange's equations).
 TEST(Dynamics, CoriolisVectorMatchesLagrangian) {
-  const auto& p = DefaultConfig().platform;
+  for (const PlatformParams& p : ModelsUnderTest()) {
   ForRandomPoses(13, kStates, [&](const Vector6d& q, std::mt19937* rng) {
     const Vector6d qd = RandomVelocity(rng);
     const double h = 1e-6;
@@ -91,6 +100,7 @@ TEST(Dynamics, CoriolisVectorMatchesLagrangian) {
     const DynamicsTerms t = EvaluateDynamics(p, q, qd);
     EXPECT_LT((t.C_qd - expected).norm(), 1e-7 * (1.0 + expected.norm())) << q.transpose();
   });
+  }
 }
 
 TEST(Dynamics, GravityIsGradientOfPotential) {

@@ -22,6 +22,7 @@ struct BodyPositions {
   Matrix3d R;
   Eigen::Matrix<double, 3, kNumLegs> unit;     // n_i
   Eigen::Matrix<double, 3, kNumLegs> rod_com;  // a_i - e2 n_i
+  Vector6d leg_length_m;
 };
 
 BodyPositions PositionsAt(const PlatformParams& p, const Vector6d& q) {
@@ -30,6 +31,7 @@ BodyPositions PositionsAt(const PlatformParams& p, const Vector6d& q) {
   b.platform_com = q.head<3>() + b.R * p.platform_com_in_P_m;
   const LegGeometry legs = ComputeLegGeometry(p, q);
   b.unit = legs.unit_in_B;
+  b.leg_length_m = legs.length_m;
   for (int i = 0; i < kNumLegs; ++i) {
     const Vector3d a = q.head<3>() + legs.platform_offset_in_B_m.col(i);
     b.rod_com.col(i) = a - p.leg.rod_com_from_platform_m * legs.unit_in_B.col(i);
@@ -61,12 +63,22 @@ double KineticEnergyFromBodies(const PlatformParams& p, const Vector6d& q, const
               0.5 * leg.cylinder_inertia_kgm2 * leg_spin_sq;
     energy +=
         0.5 * leg.rod_mass_kg * v_rod.squaredNorm() + 0.5 * leg.rod_inertia_kgm2 * leg_spin_sq;
+    const double leg_speed = (plus.leg_length_m(i) - minus.leg_length_m(i)) / (2 * h);
+    energy += 0.5 * leg.actuator_reflected_mass_kg * leg_speed * leg_speed;  // rotor
   }
   return energy;
 }
 
+// The platform with DC-motor legs' rotor inertia (the default config's
+// 80 kg reflected per leg, or less).
+PlatformParams WithRotors(PlatformParams p, double reflected_mass_kg = 80.0) {
+  p.leg.actuator_reflected_mass_kg = reflected_mass_kg;
+  return p;
+}
+
 TEST(Dynamics, KineticEnergyMatchesBodyVelocities) {
-  const auto& p = test::DefaultConfig().platform;
+  for (const PlatformParams& p :
+       {test::DefaultConfig().platform, WithRotors(test::DefaultConfig().platform)}) {
   test::ForRandomPoses(16, 500, [&](const Vector6d& q, std::mt19937* rng) {
     const Vector6d qd = test::RandomVelocity(rng);
     const double expected = KineticEnergyFromBodies(p, q, qd);
@@ -75,17 +87,19 @@ TEST(Dynamics, KineticEnergyMatchesBodyVelocities) {
     // relative; a wrong mass or inertia term is a relative error >= 1e-4.
     EXPECT_NEAR(model, expected, 1e-8 * expected) << q.transpose();
   });
+  }
 }
 
 // Every term counts: dropping any one mass parameter must change the energy
 // by far more than the tolerance above, so the test would see it.
 TEST(Dynamics, KineticEnergyTestSeesEveryMassParameter) {
-  const auto& p = test::DefaultConfig().platform;
+  // A light rotor: 80 kg would outweigh the smallest terms below the bound.
+  const PlatformParams p = WithRotors(test::DefaultConfig().platform, 0.5);
   std::mt19937 rng(17);
   const Vector6d q = test::RandomPose(&rng);
   const Vector6d qd = test::RandomVelocity(&rng);
   const double full = KineticEnergy(EvaluateDynamics(p, q, qd), qd);
-  std::vector<PlatformParams> reduced(7, p);
+  std::vector<PlatformParams> reduced(8, p);
   reduced[0].platform_mass_kg = 0.0;
   reduced[1].platform_inertia_kgm2.setZero();
   reduced[2].leg.cylinder_mass_kg = 0.0;
@@ -93,6 +107,7 @@ TEST(Dynamics, KineticEnergyTestSeesEveryMassParameter) {
   reduced[4].leg.rod_mass_kg = 0.0;
   reduced[5].leg.rod_inertia_kgm2 = 0.0;
   reduced[6].leg.rod_com_from_platform_m = 0.0;
+  reduced[7].leg.actuator_reflected_mass_kg = 0.0;
   for (size_t k = 0; k < reduced.size(); ++k) {
     const double e = KineticEnergy(EvaluateDynamics(reduced[k], q, qd), qd);
     EXPECT_GT(std::abs(full - e), 1e-4 * full) << "parameter " << k;

@@ -28,7 +28,7 @@ SensorConfig SensorsOf(const SensorConfig& sensors, bool noise) {
 
 PlantBackend::PlantBackend(const StackConfig& config, const PlantTruth& truth,
                            const PlantBackendOptions& options)
-    : plant_(PlantModelOf(truth), OdeOptionsFrom(config.plant_sim)),
+    : plant_(PlantModelOf(truth, config), OdeOptionsFrom(config.plant_sim)),
       sensors_(SensorsOf(truth.sensors, options.noise), truth.actuators,
                truth.platform.gravity_mps2, truth.sensor_errors),
       disturbance_(truth.disturbance, truth.sensors.seed),
@@ -48,12 +48,23 @@ PlantBackend::PlantBackend(const StackConfig& config, const PlantTruth& truth,
 
 void PlantBackend::Step(const DriveArray& drive, double dt_s) {
   if (!(dt_s > 0.0)) return;
+  if (plant_.model().actuators.kind == ActuatorKind::kDcMotor) {
+    // The device's legs as they are: the duty drives the motors, whose
+    // physics (dead band, back-EMF, self-locking screws) is the plant's.
+    plant_.SetActuatorsOff(false);
+    plant_.SetDutyCommand(drive_map_.Duty(drive));
+  } else {
+    StepIdealForceSource(drive);
+  }
+  plant_.SetExternalWrench(disturbance_.WrenchAt(plant_.time_s()));
+  plant_.Advance(dt_s);
+}
+
+void PlantBackend::StepIdealForceSource(const DriveArray& drive) {
   const std::array<bool, 6> locked = drive_map_.Locked(drive);
   const bool all_locked = std::all_of(locked.begin(), locked.end(), [](bool l) { return l; });
   plant_.SetActuatorsOff(all_locked);
   if (!all_locked) plant_.SetForceCommand(drive_map_.DriveToForce(drive));
-  plant_.SetExternalWrench(disturbance_.WrenchAt(plant_.time_s()));
-  plant_.Advance(dt_s);
 }
 
 RawReadings PlantBackend::Sample() {

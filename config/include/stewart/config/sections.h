@@ -24,7 +24,8 @@ ControllerConfig ParseControllerConfig(const ConfigNode& controller);
 SafetyConfig ParseSafetyConfig(const ConfigNode& safety);
 EstimatorConfig ParseEstimatorConfig(const ConfigNode& estimator);
 PlantSimConfig ParsePlantSimConfig(const ConfigNode& plant_sim);
-HwBridgeConfig ParseHwBridgeConfig(const ConfigNode& hw_bridge);
+/// `actuators` decides the drive map's source: actuators.motor for a DC motor.
+HwBridgeConfig ParseHwBridgeConfig(const ConfigNode& hw_bridge, const ActuatorConfig& actuators);
 LcmConfig ParseLcmConfig(const ConfigNode& lcm, const ConfigNode& rates);
 
 }  // namespace stewart

@@ -7,9 +7,11 @@
 #include "stewart/estimator/estimator_config.h"
 #include "stewart/hw_bridge/hw_bridge_config.h"
 #include "stewart/model/actuator_params.h"
+#include "stewart/model/dc_motor.h"
 #include "stewart/model/platform_params.h"
 #include "stewart/model/sensor_params.h"
 #include "stewart/node/lcm_config.h"
+#include "stewart/plant_sim/plant_dynamics.h"
 #include "stewart/plant_sim/plant_sim_config.h"
 #include "stewart/plant_sim/truth.h"
 #include "stewart/safety/safety_config.h"
@@ -40,6 +42,25 @@ inline PlantTruth TruthOfConfig(const StackConfig& config) {
   t.initial_pose = config.plant_sim.initial_pose;
   t.initial_velocity = config.plant_sim.initial_velocity;
   return t;
+}
+
+/// The stack's force -> duty map (the H-bridge driver): hw_bridge applies it
+/// to the device; plant_sim, standing in for hw_bridge, applies it to a
+/// DC-motor plant (PlantModel::duty_map).
+inline ForceToDutyMap DriverMapOf(const StackConfig& config) {
+  ForceToDutyMap map;
+  map.force_limit_n = config.actuators.force_limit_n;
+  map.force_at_full_duty_n = config.hw_bridge.force_at_full_duty_n;
+  map.dead_band_duty = config.hw_bridge.duty_deadband;
+  map.max_duty = config.hw_bridge.max_duty;
+  return map;
+}
+
+/// The simulated plant of a truth, driven as the stack drives it.
+inline PlantModel PlantModelOf(const PlantTruth& truth, const StackConfig& config) {
+  PlantModel model = PlantModelOf(truth);
+  model.duty_map = DriverMapOf(config);
+  return model;
 }
 
 }  // namespace stewart

@@ -34,6 +34,8 @@ class DriveMap {
   /// The inverse outside the clamps (the emulator's actuator model): a duty
   /// within the deadband gives zero force (the leg self-locks).
   Vector6d DriveToForce(const DriveArray& drive) const;
+  /// The signed duty each leg's bridge receives, drive_sign_i drive_i / full scale.
+  Vector6d Duty(const DriveArray& drive) const;
   /// True for legs whose duty is within the deadband (self-locked).
   std::array<bool, 6> Locked(const DriveArray& drive) const;
 

@@ -17,6 +17,10 @@ struct LegParams {
   double rod_mass_kg = 0.0;
   double rod_com_from_platform_m = 0.0;  ///< along the leg axis, from p_i
   double rod_inertia_kgm2 = 0.0;         ///< transverse, about its CoM
+  /// The actuator's rotor inertia seen along the leg axis (kg): kinetic
+  /// energy 1/2 m_r Ld^2 (DcMotorParams::reflected_mass_kg; 0 for an ideal
+  /// force source).
+  double actuator_reflected_mass_kg = 0.0;
 };
 
 struct PlatformParams {

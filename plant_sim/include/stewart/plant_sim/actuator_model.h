@@ -35,6 +35,26 @@ double EndStopPotentialEnergy(const ActuatorConfig& actuators, const Vector6d& l
 Vector6d LegLockForce(const ActuatorConfig& actuators, const Vector6d& leg_length_m,
                       const Vector6d& leg_speed_mps, const Vector6d& lock_length_m);
 
+/// DC motor: the drive force of each leg's duty, u_eff(duty) F_full (N);
+/// zero when the power is off.
+Vector6d DcMotorDriveForce(const DcMotorParams& motor, const Vector6d& duty, bool power_off);
+
+/// True iff the duty energises the motor (outside the dead band, power on).
+bool DcMotorEnergised(const DcMotorParams& motor, double duty, bool power_off);
+
+/// DC motor: the leg forces besides the drive force and the screw's viscous
+/// friction (N): back-EMF damping -b_emf Ld (power on), the screw's dry
+/// friction -F tanh(Ld / kCoulombSpeedScaleMps) with F = coulomb_friction_n
+/// while energised and back_drive_force_n while not, and for held legs the
+/// screw's spring -k (L - L_held) - c Ld, c critical with the reflected mass.
+struct PlantInputs;
+Vector6d DcMotorLegForce(const ActuatorConfig& actuators, const PlantInputs& inputs,
+                         const Vector6d& leg_length_m, const Vector6d& leg_speed_mps);
+
+/// Damping of a held leg's spring (N s/m): critical for the reflected mass
+/// (at least 0.1 kg, so a massless rotor still damps).
+double DcMotorHoldDampingNspm(const DcMotorParams& motor);
+
 /// First-order force lag tau dF/dt = F_sat - F (tau = force_lag_s > 0).
 Vector6d ForceLagRate(const ActuatorConfig& actuators, const Vector6d& force_sat_n,
                       const Vector6d& force_motor_n);

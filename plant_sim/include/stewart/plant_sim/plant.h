@@ -15,6 +15,8 @@ struct PlantCounters {
   /// Intervals the explicit integrator failed on (stiff end-stop chatter)
   /// and the implicit BDF fallback integrated instead.
   long stiff_fallbacks = 0;
+  /// DC motor: times a leg's self-locking screw took hold of it.
+  long self_lock_engagements = 0;
   OdeStats ode;
 };
 
@@ -29,10 +31,16 @@ class Plant {
   /// Zero-order hold: the command acts from now + model().command_delay_s
   /// until the next change takes effect. A change restarts the integrator,
   /// since f(x) jumps.
+  /// A DC-motor plant turns the force into a duty by model().duty_map (the
+  /// driver plant_sim stands in for) and holds that.
   void SetForceCommand(const Vector6d& force_cmd_n);
+  /// DC motor only (throws std::logic_error otherwise): the PWM duty per leg,
+  /// as the device receives it. Held and delayed like a force command.
+  void SetDutyCommand(const Vector6d& duty);
   /// Actuators off: zero force, and the lead screws hold every leg at its
-  /// length at this instant (LegLockForce); drops commands not yet in effect.
-  /// Restarts the integrator on change.
+  /// length at this instant (LegLockForce; a DC motor's legs self-lock one by
+  /// one as they stop); drops commands not yet in effect. Restarts the
+  /// integrator on change.
   void SetActuatorsOff(bool off);
   /// External wrench from now on ([N; N m] in {B}, PlantInputs).
   void SetExternalWrench(const Vector6d& wrench);
@@ -66,12 +74,20 @@ class Plant {
  private:
   struct DelayedCommand {
     double apply_s;
-    Vector6d force_cmd_n;
+    Vector6d command;  // force (N) or, for a DC motor, duty
   };
   // Room for 0.5 s of delay at 1 kHz: far beyond any latency worth simulating.
   static constexpr int kDelayCapacity = 512;
 
-  void ApplyForceCommand(const Vector6d& force_cmd_n);
+  void QueueCommand(const Vector6d& command);
+  // Force (ideal source) or duty (DC motor) from now on.
+  void ApplyCommand(const Vector6d& command);
+  // DC motor: which legs the self-locking screws hold, judged at the state
+  // now (between integration intervals): a leg whose motor is not energised
+  // is taken hold of once its speed falls below kHoldSpeedMps, and let go
+  // when the motor is energised or its spring carries more than the
+  // back-drive force.
+  void UpdateSelfLocking();
   void IntegrateTo(double t_end);
   // The integration loop of IntegrateTo with `integrator`, from (t_s_, x_);
   // throws as OdeIntegrator::Advance does.
@@ -105,6 +121,7 @@ class Plant {
   double t_s_ = 0.0;
   bool restart_pending_ = true;
   long endstop_hits_ = 0;
+  long self_lock_engagements_ = 0;
   long inputs_revision_ = 0;
   std::array<DelayedCommand, kDelayCapacity> delayed_{};  // ring, in time order
   int delayed_head_ = 0;

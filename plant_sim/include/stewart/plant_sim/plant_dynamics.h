@@ -12,9 +12,20 @@
 //              integrates only q and qd (docs/simulation.md, "Integrator").
 // k (force gain) and F_c (Coulomb friction) come from the truth
 // (truth.h); the model's defaults are k = 1, F_c = 0.
+//
+// With a DC-motor actuator (ActuatorKind::kDcMotor, model/dc_motor.h) the
+// input is the PWM duty and sat(F_cmd) becomes the drive force of the duty,
+// F_drive = u_eff(duty) F_full; the leg force adds the back-EMF damping
+// -b_emf Ld (not when the power is off: open terminals), the screw's dry
+// friction (coulomb_friction_n while the motor is energised,
+// back_drive_force_n while it is not: the screw self-locks) and, for a leg
+// the screw holds (PlantInputs::leg_held), a stiff spring to its held
+// length; the rotor's reflected mass is in M (PlatformParams::leg).
 #include <Eigen/Core>
+#include <array>
 
 #include "stewart/model/actuator_params.h"
+#include "stewart/model/dc_motor.h"
 #include "stewart/model/dynamics.h"
 #include "stewart/model/platform_params.h"
 #include "stewart/plant_sim/truth.h"
@@ -32,12 +43,20 @@ struct PlantModel {
       : platform(platform_params),
         actuators(actuator_config),
         actuator_errors(errors),
-        command_delay_s(delay_s) {}
+        command_delay_s(delay_s),
+        duty_map(DriverOf(actuator_config)) {}
+
+  /// The driver that matches these actuators exactly (its own motor map).
+  static ForceToDutyMap DriverOf(const ActuatorConfig& actuators);
 
   PlatformParams platform;
   ActuatorConfig actuators;
   ActuatorTruth actuator_errors;
   double command_delay_s = 0.0;  ///< a command acts this long after it is set
+  /// DC motor only: how Plant::SetForceCommand turns a force into a duty
+  /// (the H-bridge driver plant_sim stands in for; the stack's own map, from
+  /// its config, not the truth's).
+  ForceToDutyMap duty_map;
 };
 
 /// The plant of a truth.
@@ -48,9 +67,17 @@ inline PlantModel PlantModelOf(const PlantTruth& truth) {
 
 /// Inputs held constant over one integration interval (zero-order hold).
 struct PlantInputs {
-  Vector6d force_cmd_n = Vector6d::Zero();  ///< commanded leg forces, before saturation
-  bool legs_locked = false;                 ///< unpowered: the lead screws hold their length
+  Vector6d force_cmd_n = Vector6d::Zero();  ///< ideal force source: commanded forces (N)
+  Vector6d duty = Vector6d::Zero();         ///< DC motor: PWM duty in [-1, 1]
+  /// Unpowered. Ideal force source: the lead screws hold every leg at
+  /// lock_length_m. DC motor: no drive and no back-EMF; each leg self-locks
+  /// as leg_held says.
+  bool legs_locked = false;
   Vector6d lock_length_m = Vector6d::Zero();
+  /// DC motor: legs the self-locking screw holds, at hold_length_m (Plant
+  /// decides at each step: UpdateSelfLocking).
+  std::array<bool, kNumLegs> leg_held{};
+  Vector6d hold_length_m = Vector6d::Zero();
   /// External wrench on the platform, [force (N); torque (N m)] in {B},
   /// force through the origin of {P} (GeneralisedForceOfWrench).
   Vector6d external_wrench = Vector6d::Zero();

@@ -14,6 +14,11 @@
 // watchdog, enable clear, or a bridge that zeroes the drive) mean the motors
 // are unpowered and the lead screws hold every leg (Plant::SetActuatorsOff),
 // as plant_sim's "off" fallback does.
+//
+// A truth with DC-motor actuators (actuators.model dc_motor) takes the duty
+// itself: drive counts --(drive signs)--> PWM duty --> stewart::Plant's motor
+// model (dead band, bridge drop, back-EMF, rotor inertia, self-locking
+// screws, docs/simulation.md); nothing inverts the bridge's map.
 #include <memory>
 
 #include "stewart/config/stack_config.h"
@@ -55,7 +60,8 @@ class PlantBackend final : public DeviceBackend {
   /// Ground truth (evaluation only: a real device has none).
   Vector6d q() const { return plant_.q(); }
   Vector6d qd() const { return plant_.qd(); }
-  /// Leg force commands (N) the last Step applied, from the drive.
+  /// Leg force commands (N) the last Step applied, from the drive (ideal
+  /// force source; a DC-motor plant's input is plant().inputs().duty).
   const Vector6d& force_cmd_n() const { return plant_.inputs().force_cmd_n; }
   bool actuators_off() const { return plant_.actuators_off(); }
   const Plant& plant() const { return plant_; }
@@ -66,6 +72,8 @@ class PlantBackend final : public DeviceBackend {
   DisturbanceSource disturbance_;
   LegCalibration calibration_;
   ImuScale imu_;
+  void StepIdealForceSource(const DriveArray& drive);
+
   DriveMap drive_map_;
   double adc_max_;
   double min_length_m_;
