@@ -99,11 +99,7 @@ ActuatorConfig ParseActuatorConfig(const ConfigNode& actuators) {
   a.min_length_m = actuators.PositiveDouble("min_length_m");
   a.stroke_m = actuators.PositiveDouble("stroke_m");
   a.force_limit_n = actuators.PositiveDouble("force_limit_n");
-  if (a.kind == ActuatorKind::kDcMotor && a.force_limit_n > DcMotorForceAtFullDuty(a.motor)) {
-    actuators.Fail("force_limit_n", "exceeds the motor's force at full duty (" +
-                                        std::to_string(DcMotorForceAtFullDuty(a.motor)) +
-                                        " N from actuators.motor)");
-  }
+
   a.viscous_friction_nspm = actuators.NonNegativeDouble("viscous_friction_nspm");
   a.force_lag_s = actuators.NonNegativeDouble("force_lag_s");
   a.endstop_stiffness_npm = actuators.PositiveDouble("endstop_stiffness_npm");

@@ -4,6 +4,7 @@
 
 #include "stewart/estimator/measurement_models.h"
 #include "stewart/estimator/process_model.h"
+#include "stewart/model/dc_motor.h"
 #include "stewart/model/kinematics.h"
 
 namespace stewart {
@@ -116,6 +117,7 @@ Ekf::Ekf(const PlatformParams& params, const ActuatorConfig& actuators, const Se
          const EstimatorConfig& config, const Vector6d& home_pose)
     : params_(params),
       actuators_(actuators),
+      leg_damping_nspm_(ModelLegDampingNspm(actuators)),
       config_(config),
       home_pose_(home_pose),
       imu_offset_m_(sensors.imu_offset_in_P_m) {
@@ -241,7 +243,7 @@ void Ekf::Predict(double dt_s, int64_t utime, const EulerAngleTrig& trig, uint32
   double sigma_lin = config_.process_accel_std_mps2;
   double sigma_ang = config_.process_angaccel_std_radps2;
   if (use_dynamics) {
-    DynamicsAccelerationJacobians(params_, actuators_.viscous_friction_nspm, q, trig, qd,
+    DynamicsAccelerationJacobians(params_, leg_damping_nspm_, q, trig, qd,
                                   command->force_n, x_.segment<6>(kEkfDisturbance), &qdd_,
                                   &dqdd_dq_, &dqdd_dqd_, &m_inv_);
     sigma_lin = config_.dynamics_accel_std_mps2;

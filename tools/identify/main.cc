@@ -14,6 +14,7 @@
 #include <fstream>
 
 #include "log_samples.h"
+#include "stewart/model/dc_motor.h"
 #include "stewart/config/config_loader.h"
 #include "stewart/identify/inertial_fit.h"
 #include "stewart/identify/overlay_writer.h"
@@ -128,7 +129,7 @@ int Identify(const Options& o) {
   stewart::identify::InertialFitOptions fit_options;
   fit_options.window_s = o.window_s;
   const stewart::identify::InertialFit fit = stewart::identify::FitInertialParameters(
-      config.platform, config.actuators.viscous_friction_nspm, log.samples, fit_options);
+      config.platform, ModelLegDampingNspm(config.actuators), log.samples, fit_options);
   const stewart::identify::PlatformEstimate estimate = stewart::identify::EstimatePlatform(fit);
   provenance += "\nstate: " + state_channel + ", identified " + Now("%Y-%m-%d %H:%M") +
                 "\napply with: tools/launch.sh --overlay " + o.out_path;

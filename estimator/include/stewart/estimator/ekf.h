@@ -61,6 +61,7 @@ class Ekf {
 
   PlatformParams params_;
   ActuatorConfig actuators_;
+  double leg_damping_nspm_;  // N s/m: screw friction + back-EMF (ModelLegDampingNspm)
   EstimatorConfig config_;
   Vector6d home_pose_;
   Vector3d imu_offset_m_;
