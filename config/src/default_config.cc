@@ -7,4 +7,13 @@ const StackConfig& DefaultStackConfig() {
   return config;
 }
 
+std::string DcMotorOverlayPath() {
+  return std::string(STEWART_SOURCE_DIR) + "/config/overlays/p16p.yaml";
+}
+
+const StackConfig& DcMotorStackConfig() {
+  static const StackConfig config = LoadStackConfig(DefaultConfigPath(), {DcMotorOverlayPath()});
+  return config;
+}
+
 }  // namespace stewart

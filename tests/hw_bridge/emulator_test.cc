@@ -215,8 +215,20 @@ TEST(PlantBackend, SamplesDecodeBackToTheTrueLegLengths) {
 // a closed loop, against plant_sim's Plant and SensorModel driven with the
 // same forces (as plant_sim in lockstep: the force answering sample k acts
 // from t_k). Both sides must agree up to the drive and ADC quantisation.
-TEST(PlantBackend, BridgePlusEmulatorEqualsPlantSim) {
-  const StackConfig& c = test::Config();
+// The leg-space PD both sides run on their own ground truth: gains (N/m,
+// N s/m) and the amplitude (m) of the 0.5 Hz leg motion it tracks.
+struct SwapControl {
+  double kp_npm;
+  double kd_nspm;
+  double amplitude_m;
+  /// Accelerometer samples allowed beyond the rounding bound (and then
+  /// within 3 noise std instead of 1).
+  int accel_outliers_allowed = 0;
+};
+
+// Device emulator behind hw_bridge's maps vs plant_sim's library driven
+// directly, with the same control law on each side's ground truth.
+void ExpectBridgePlusEmulatorEqualsPlantSim(const StackConfig& c, const SwapControl& gains) {
   constexpr int kTicks = 3000;  // 3 s at 1 kHz
   constexpr int64_t kPeriodUs = 1000;
   constexpr uint64_t kDeviceEpochUs = 7'000'000;
@@ -233,7 +245,7 @@ TEST(PlantBackend, BridgePlusEmulatorEqualsPlantSim) {
   OdeOptions ode;
   ode.rel_tol = c.plant_sim.rel_tol;
   ode.abs_tol = c.plant_sim.abs_tol;
-  Plant plant(PlantModel{c.platform, c.actuators}, ode);
+  Plant plant(PlantModelOf(TruthOfConfig(c), c), ode);
   plant.Reset(0.0, c.home_pose, Vector6d::Zero());
   plant.SetActuatorsOff(true);
   plant.Advance(PlantBackendOptions{}.power_on_settle_s);  // as the device at power-on
@@ -246,10 +258,10 @@ TEST(PlantBackend, BridgePlusEmulatorEqualsPlantSim) {
   // motion at 0.5 Hz: forces stay well outside the bridge's dead zone.
   const auto control = [&](const Vector6d& q, const Vector6d& qd, double t_s) {
     const DynamicsTerms terms = EvaluateDynamics(c.platform, q, qd);
-    const Vector6d l_ref =
-        l_home + Vector6d::LinSpaced(-1.0, 1.0) * 4e-3 * std::sin(2.0 * M_PI * 0.5 * t_s);
-    return Vector6d(f_hold + 300.0 * (l_ref - terms.leg_length_m) -
-                    30.0 * (terms.H.transpose() * qd));
+    const Vector6d l_ref = l_home + Vector6d::LinSpaced(-1.0, 1.0) * gains.amplitude_m *
+                                        std::sin(2.0 * M_PI * 0.5 * t_s);
+    return Vector6d(f_hold + gains.kp_npm * (l_ref - terms.leg_length_m) -
+                    gains.kd_nspm * (terms.H.transpose() * qd));
   };
 
   const double count_m =
@@ -258,7 +270,8 @@ TEST(PlantBackend, BridgePlusEmulatorEqualsPlantSim) {
   double max_dq = 0.0, max_dqd = 0.0, max_drate = 0.0, max_dgyro = 0.0, max_daccel = 0.0,
          min_force = 1e9;
   long legs_within_a_count = 0, legs_total = 0;
-  double max_dleg = 0.0;
+  double max_dleg = 0.0, max_travel = 0.0;
+  int accel_outliers = 0;
   int64_t last_utime = 0;
   for (int k = 0; k < kTicks; ++k) {
     const double t_s = k * kPeriodUs * 1e-6;
@@ -276,6 +289,7 @@ TEST(PlantBackend, BridgePlusEmulatorEqualsPlantSim) {
     const SensorReading reading =
         sensors.Sample(plant.q(), plant.qd(), rates.x_dot.segment<6>(6), rates.terms.leg_length_m);
     max_dq = std::max(max_dq, (backend.q() - plant.q()).cwiseAbs().maxCoeff());
+    max_travel = std::max(max_travel, (rates.terms.leg_length_m - l_home).cwiseAbs().maxCoeff());
     const Vector6d dqd = backend.qd() - plant.qd();
     max_dqd = std::max(max_dqd, dqd.head<3>().cwiseAbs().maxCoeff());
     max_drate = std::max(max_drate, dqd.tail<3>().cwiseAbs().maxCoeff());
@@ -286,8 +300,9 @@ TEST(PlantBackend, BridgePlusEmulatorEqualsPlantSim) {
       ++legs_total;
     }
     max_dgyro = std::max(max_dgyro, (sample.gyro_radps - reading.gyro_radps).cwiseAbs().maxCoeff());
-    max_daccel =
-        std::max(max_daccel, (sample.accel_mps2 - reading.accel_mps2).cwiseAbs().maxCoeff());
+    const double daccel = (sample.accel_mps2 - reading.accel_mps2).cwiseAbs().maxCoeff();
+    max_daccel = std::max(max_daccel, daccel);
+    if (daccel > 0.5 * c.hw_bridge.accel_mps2_per_lsb + 0.01) ++accel_outliers;
 
     // The force answering sample k, on both sides from t_k.
     const Vector6d f_emu = control(backend.q(), backend.qd(), t_s);
@@ -323,8 +338,28 @@ TEST(PlantBackend, BridgePlusEmulatorEqualsPlantSim) {
   // Half an LSB plus the rate difference above; both far below the noise.
   EXPECT_LE(max_dgyro, 0.5 * c.hw_bridge.gyro_radps_per_lsb + 5e-4);
   EXPECT_LT(max_dgyro, c.sensors.gyro_noise_std_radps);
-  EXPECT_LE(max_daccel, 0.5 * c.hw_bridge.accel_mps2_per_lsb + 0.01);
-  EXPECT_LT(max_daccel, c.sensors.accel_noise_std_mps2);
+  EXPECT_LE(accel_outliers, gains.accel_outliers_allowed);
+  EXPECT_LT(max_daccel, gains.accel_outliers_allowed > 0 ? 3.0 * c.sensors.accel_noise_std_mps2
+                                                         : c.sensors.accel_noise_std_mps2);
+  EXPECT_GT(max_travel, 0.5 * gains.amplitude_m);  // the legs did follow
+}
+
+TEST(PlantBackend, BridgePlusEmulatorEqualsPlantSim) {
+  // 4 mm of leg motion: forces stay well outside the bridge's dead zone.
+  ExpectBridgePlusEmulatorEqualsPlantSim(test::Config(), SwapControl{300.0, 30.0, 4e-3});
+}
+
+// The same with the P-16P legs: the emulator drives its motors with the duty
+// it receives, plant_sim turns the force into a duty by the same map
+// (unquantised). The motors' back-EMF damps the legs, so the PD is stiff and
+// has no damping of its own; 1 mm at 0.5 Hz keeps the duty below 0.4. Where
+// a leg reverses, the emulator's duty, rounded to a count, can sit on the
+// dead band's edge for one sample while plant_sim's is just outside it: that
+// motor is off for 1 ms and the screw's friction jolts the accelerometer
+// (2 samples of 3000 here).
+TEST(PlantBackend, BridgePlusEmulatorEqualsPlantSimWithDcMotorLegs) {
+  const StackConfig c = test::DcMotorConfig();
+  ExpectBridgePlusEmulatorEqualsPlantSim(c, SwapControl{3e4, 0.0, 1e-3, 6});
 }
 
 }  // namespace

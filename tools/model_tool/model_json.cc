@@ -2,6 +2,7 @@
 
 #include <stdexcept>
 
+#include "stewart/model/dc_motor.h"
 #include "stewart/model/dynamics.h"
 #include "stewart/model/kinematics.h"
 
@@ -50,7 +51,8 @@ ModelQuery ParseModelQuery(const nlohmann::json& in, const Vector6d& default_q) 
   return query;
 }
 
-nlohmann::json EvaluateModelQuery(const PlatformParams& params, const ModelQuery& query) {
+nlohmann::json EvaluateModelQuery(const PlatformParams& params, const ModelQuery& query,
+                                  const ActuatorConfig* actuators) {
   nlohmann::json out;
   out["q"] = ToJson(query.q);
   out["qd"] = ToJson(query.qd);
@@ -79,6 +81,19 @@ nlohmann::json EvaluateModelQuery(const PlatformParams& params, const ModelQuery
   out["inverse_dynamics_F"] = ToJson(InverseDynamics(terms, query.qdd));
   out["kinetic_energy_j"] = KineticEnergy(terms, query.qd);
   out["potential_energy_j"] = PotentialEnergy(params, query.q);
+  if (actuators != nullptr) {
+    const Vector6d leg_speed_mps = terms.H.transpose() * query.qd;
+    const Vector6d command_n =
+        InverseDynamics(terms, query.qdd) + ModelLegDampingNspm(*actuators) * leg_speed_mps;
+    nlohmann::json legs_out;
+    legs_out["leg_speed_mps"] = ToJson(leg_speed_mps);
+    legs_out["command_force_n"] = ToJson(command_n);
+    legs_out["force_limit_share"] = command_n.cwiseAbs().maxCoeff() / actuators->force_limit_n;
+    if (actuators->kind == ActuatorKind::kDcMotor) {
+      legs_out["duty"] = ToJson(DcMotorDutyForDriveForce(actuators->motor, command_n));
+    }
+    out["actuators"] = legs_out;
+  }
   if (query.has_leg_lengths) {
     const ForwardKinematicsResult fk = ForwardKinematics(params, query.leg_length_m, query.q);
     out["forward_kinematics"] = {{"q", ToJson(fk.q)},

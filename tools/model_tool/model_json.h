@@ -2,6 +2,7 @@
 // JSON in and out for the model tool.
 #include <nlohmann/json.hpp>
 
+#include "stewart/model/actuator_params.h"
 #include "stewart/model/platform_params.h"
 #include "stewart/model/types.h"
 
@@ -22,6 +23,11 @@ struct ModelQuery {
 ModelQuery ParseModelQuery(const nlohmann::json& in, const Vector6d& default_q);
 
 /// Evaluates everything the model offers for one query.
-nlohmann::json EvaluateModelQuery(const PlatformParams& params, const ModelQuery& query);
+/// With `actuators`, also what the legs must do: the leg speeds and, per
+/// leg, the force the stack commands for qdd at qd (inverse dynamics plus
+/// the modelled leg damping, N), its share of the force limit and, for a DC
+/// motor, its duty (docs/safety.md, "What the limits ask of the motors").
+nlohmann::json EvaluateModelQuery(const PlatformParams& params, const ModelQuery& query,
+                                  const ActuatorConfig* actuators = nullptr);
 
 }  // namespace stewart
