@@ -41,10 +41,10 @@ StackConfig ParseRoot(const YAML::Node& yaml, const std::string& source) {
   // may have weaker motors: that is the plant's business, not checked there).
   if (c.actuators.kind == ActuatorKind::kDcMotor &&
       c.actuators.force_limit_n > DcMotorForceAtFullDuty(c.actuators.motor)) {
-    root.Child("actuators").Fail("force_limit_n",
-                                 "exceeds the motor's force at full duty (" +
-                                     Fmt(DcMotorForceAtFullDuty(c.actuators.motor)) +
-                                     " N from actuators.motor)");
+    root.Child("actuators")
+        .Fail("force_limit_n", "exceeds the motor's force at full duty (" +
+                                   Fmt(DcMotorForceAtFullDuty(c.actuators.motor)) +
+                                   " N from actuators.motor)");
   }
   c.sensors = ParseSensorConfig(root.Child("sensors"));
   c.controller = ParseControllerConfig(root.Child("controller"));

@@ -31,11 +31,17 @@ const std::set<std::string> kPlatformKeys = {"base_joint_radius_m",
 const std::set<std::string> kLegKeys = {"cylinder_mass_kg",        "cylinder_com_from_base_m",
                                         "cylinder_inertia_kgm2",   "rod_mass_kg",
                                         "rod_com_from_platform_m", "rod_inertia_kgm2"};
-const std::set<std::string> kActuatorKeys = {
-    "min_length_m",          "stroke_m",    "force_limit_n",
-    "viscous_friction_nspm", "force_lag_s", "endstop_stiffness_npm",
-    "endstop_damping_nspm",  "force_gain",  "coulomb_friction_n",
-    "model",                 "motor"};
+const std::set<std::string> kActuatorKeys = {"min_length_m",
+                                             "stroke_m",
+                                             "force_limit_n",
+                                             "viscous_friction_nspm",
+                                             "force_lag_s",
+                                             "endstop_stiffness_npm",
+                                             "endstop_damping_nspm",
+                                             "force_gain",
+                                             "coulomb_friction_n",
+                                             "model",
+                                             "motor"};
 const std::set<std::string> kSensorKeys = {"rate_hz",
                                            "leg_pot_noise_std_m",
                                            "leg_adc_bits",
@@ -189,7 +195,8 @@ PlantTruth ParsePlantTruth(const StackConfig& config, const YAML::Node& config_r
       YAML::Node target = merged[section][name];
       // actuators.motor: key by key too, so a truth can change one motor parameter.
       if (section == "actuators" && name == "motor" && key.second.IsMap() && target.IsMap()) {
-        for (const auto& sub : key.second) target[sub.first.as<std::string>()] = YAML::Clone(sub.second);
+        for (const auto& sub : key.second)
+          target[sub.first.as<std::string>()] = YAML::Clone(sub.second);
       } else {
         merged[section][name] = YAML::Clone(key.second);
       }

@@ -243,9 +243,9 @@ void Ekf::Predict(double dt_s, int64_t utime, const EulerAngleTrig& trig, uint32
   double sigma_lin = config_.process_accel_std_mps2;
   double sigma_ang = config_.process_angaccel_std_radps2;
   if (use_dynamics) {
-    DynamicsAccelerationJacobians(params_, leg_damping_nspm_, q, trig, qd,
-                                  command->force_n, x_.segment<6>(kEkfDisturbance), &qdd_,
-                                  &dqdd_dq_, &dqdd_dqd_, &m_inv_);
+    DynamicsAccelerationJacobians(params_, leg_damping_nspm_, q, trig, qd, command->force_n,
+                                  x_.segment<6>(kEkfDisturbance), &qdd_, &dqdd_dq_, &dqdd_dqd_,
+                                  &m_inv_);
     sigma_lin = config_.dynamics_accel_std_mps2;
     sigma_ang = config_.dynamics_angaccel_std_radps2;
   } else {

@@ -41,7 +41,8 @@ Vector6d DcMotorDutyForDriveForce(const DcMotorParams& motor, const Vector6d& dr
 double DutyForForce(const ForceToDutyMap& map, double force_n) {
   if (!std::isfinite(force_n) || force_n == 0.0) return 0.0;
   const double f = std::min(std::abs(force_n), map.force_limit_n);
-  const double duty = map.dead_band_duty + (1.0 - map.dead_band_duty) * f / map.force_at_full_duty_n;
+  const double duty =
+      map.dead_band_duty + (1.0 - map.dead_band_duty) * f / map.force_at_full_duty_n;
   return std::copysign(std::min(duty, map.max_duty), force_n);
 }
 

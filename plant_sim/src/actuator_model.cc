@@ -87,8 +87,8 @@ Vector6d DcMotorLegForce(const ActuatorConfig& actuators, const PlantInputs& inp
                            : motor.back_drive_force_n;
     force(i) = -b_emf * ld - dry * std::tanh(ld / kCoulombSpeedScaleMps);
     if (inputs.leg_held[static_cast<std::size_t>(i)]) {
-      force(i) += -motor.lock_stiffness_npm * (leg_length_m(i) - inputs.hold_length_m(i)) -
-                  c_hold * ld;
+      force(i) +=
+          -motor.lock_stiffness_npm * (leg_length_m(i) - inputs.hold_length_m(i)) - c_hold * ld;
     }
   }
   return force;

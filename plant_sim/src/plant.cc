@@ -117,9 +117,9 @@ void Plant::UpdateSelfLocking() {
     if (energised) {
       hold = false;
     } else if (held) {
-      const double spring_n = motor.lock_stiffness_npm *
-                                  (leg_length_m(i) - inputs_.hold_length_m(i)) +
-                              c_hold * leg_speed_mps(i);
+      const double spring_n =
+          motor.lock_stiffness_npm * (leg_length_m(i) - inputs_.hold_length_m(i)) +
+          c_hold * leg_speed_mps(i);
       hold = std::abs(spring_n) <= motor.back_drive_force_n;
     } else if (std::abs(leg_speed_mps(i)) < kHoldSpeedMps) {
       hold = true;

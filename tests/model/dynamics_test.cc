@@ -71,13 +71,13 @@ std::vector<PlatformParams> ModelsUnderTest() {
 
 TEST(Dynamics, PowerBalance) {
   for (const PlatformParams& p : ModelsUnderTest()) {
-  ForRandomPoses(12, kStates, [&](const Vector6d& q, std::mt19937* rng) {
-    const Vector6d qd = RandomVelocity(rng);
-    const Matrix6d Mdot = MassMatrixRate(p, q, qd);
-    const DynamicsTerms t = EvaluateDynamics(p, q, qd);
-    const double scale = std::abs(qd.dot(Mdot * qd)) + 2 * std::abs(qd.dot(t.C_qd)) + 1e-12;
-    EXPECT_LT(std::abs(qd.dot(Mdot * qd) - 2.0 * qd.dot(t.C_qd)) / scale, 1e-7);
-  });
+    ForRandomPoses(12, kStates, [&](const Vector6d& q, std::mt19937* rng) {
+      const Vector6d qd = RandomVelocity(rng);
+      const Matrix6d Mdot = MassMatrixRate(p, q, qd);
+      const DynamicsTerms t = EvaluateDynamics(p, q, qd);
+      const double scale = std::abs(qd.dot(Mdot * qd)) + 2 * std::abs(qd.dot(t.C_qd)) + 1e-12;
+      EXPECT_LT(std::abs(qd.dot(Mdot * qd) - 2.0 * qd.dot(t.C_qd)) / scale, 1e-7);
+    });
   }
 }
 
@@ -85,21 +85,21 @@ TEST(Dynamics, PowerBalance) {
 // (Lagrange's equations).
 TEST(Dynamics, CoriolisVectorMatchesLagrangian) {
   for (const PlatformParams& p : ModelsUnderTest()) {
-  ForRandomPoses(13, kStates, [&](const Vector6d& q, std::mt19937* rng) {
-    const Vector6d qd = RandomVelocity(rng);
-    const double h = 1e-6;
-    const Matrix6d Mdot = MassMatrixRate(p, q, qd);
-    Vector6d dT_dq;
-    for (int j = 0; j < 6; ++j) {
-      Vector6d dq = Vector6d::Zero();
-      dq(j) = h;
-      dT_dq(j) =
-          0.5 * (qd.dot(MassMatrix(p, q + dq) * qd) - qd.dot(MassMatrix(p, q - dq) * qd)) / (2 * h);
-    }
-    const Vector6d expected = Mdot * qd - dT_dq;
-    const DynamicsTerms t = EvaluateDynamics(p, q, qd);
-    EXPECT_LT((t.C_qd - expected).norm(), 1e-7 * (1.0 + expected.norm())) << q.transpose();
-  });
+    ForRandomPoses(13, kStates, [&](const Vector6d& q, std::mt19937* rng) {
+      const Vector6d qd = RandomVelocity(rng);
+      const double h = 1e-6;
+      const Matrix6d Mdot = MassMatrixRate(p, q, qd);
+      Vector6d dT_dq;
+      for (int j = 0; j < 6; ++j) {
+        Vector6d dq = Vector6d::Zero();
+        dq(j) = h;
+        dT_dq(j) = 0.5 * (qd.dot(MassMatrix(p, q + dq) * qd) - qd.dot(MassMatrix(p, q - dq) * qd)) /
+                   (2 * h);
+      }
+      const Vector6d expected = Mdot * qd - dT_dq;
+      const DynamicsTerms t = EvaluateDynamics(p, q, qd);
+      EXPECT_LT((t.C_qd - expected).norm(), 1e-7 * (1.0 + expected.norm())) << q.transpose();
+    });
   }
 }
 

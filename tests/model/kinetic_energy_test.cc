@@ -79,14 +79,14 @@ PlatformParams WithRotors(PlatformParams p, double reflected_mass_kg = 80.0) {
 TEST(Dynamics, KineticEnergyMatchesBodyVelocities) {
   for (const PlatformParams& p :
        {test::DefaultConfig().platform, WithRotors(test::DefaultConfig().platform)}) {
-  test::ForRandomPoses(16, 500, [&](const Vector6d& q, std::mt19937* rng) {
-    const Vector6d qd = test::RandomVelocity(rng);
-    const double expected = KineticEnergyFromBodies(p, q, qd);
-    const double model = KineticEnergy(EvaluateDynamics(p, q, qd), qd);
-    // Central differences at h = 1e-6: truncation ~1e-12, round-off ~1e-10
-    // relative; a wrong mass or inertia term is a relative error >= 1e-4.
-    EXPECT_NEAR(model, expected, 1e-8 * expected) << q.transpose();
-  });
+    test::ForRandomPoses(16, 500, [&](const Vector6d& q, std::mt19937* rng) {
+      const Vector6d qd = test::RandomVelocity(rng);
+      const double expected = KineticEnergyFromBodies(p, q, qd);
+      const double model = KineticEnergy(EvaluateDynamics(p, q, qd), qd);
+      // Central differences at h = 1e-6: truncation ~1e-12, round-off ~1e-10
+      // relative; a wrong mass or inertia term is a relative error >= 1e-4.
+      EXPECT_NEAR(model, expected, 1e-8 * expected) << q.transpose();
+    });
   }
 }
 

@@ -96,7 +96,8 @@ TEST(DcMotorLeg, StallForceAtTheStrokeEnd) {
   const Vector6d lengths = InverseKinematics(model.platform, plant.q());
   const Vector6d stop_n = EndStopForce(model.actuators, lengths, LegSpeed(plant));
   const double f_full = DcMotorForceAtFullDuty(model.actuators.motor);
-  spdlog::info("end-stop forces {:.2f} to {:.2f} N (stall {:.2f} N)", stop_n.minCoeff(), stop_n.maxCoeff(), f_full);
+  spdlog::info("end-stop forces {:.2f} to {:.2f} N (stall {:.2f} N)", stop_n.minCoeff(),
+               stop_n.maxCoeff(), f_full);
   EXPECT_GT(plant.counters().endstop_hits, 0);
   EXPECT_LT(LegSpeed(plant).cwiseAbs().maxCoeff(), 1e-6);
   for (int i = 0; i < kNumLegs; ++i) EXPECT_NEAR(-stop_n(i), f_full, 0.01 * f_full) << i;
@@ -119,8 +120,8 @@ TEST(DcMotorLeg, SelfLockingHoldsBelowTheBackDriveForceAndGivesWayAbove) {
   const PlantModel model = DcMotorModel();
   const double f_bd = model.actuators.motor.back_drive_force_n;
   const Vector6d q0 = Config().plant_sim.initial_pose;
-  const Vector6d per_newton = StaticLegForces(model.platform, q0, 1.0) -
-                              StaticLegForces(model.platform, q0, 0.0);
+  const Vector6d per_newton =
+      StaticLegForces(model.platform, q0, 1.0) - StaticLegForces(model.platform, q0, 0.0);
   const Vector6d weight_n = StaticLegForces(model.platform, q0, 0.0);
   ASSERT_TRUE((per_newton.array() > 0.0).all());
   const double hold_load_n = ((0.8 * f_bd - weight_n.array()) / per_newton.array()).minCoeff();

@@ -14,11 +14,11 @@
 #include <fstream>
 
 #include "log_samples.h"
-#include "stewart/model/dc_motor.h"
 #include "stewart/config/config_loader.h"
 #include "stewart/identify/inertial_fit.h"
 #include "stewart/identify/overlay_writer.h"
 #include "stewart/identify/platform_estimate.h"
+#include "stewart/model/dc_motor.h"
 #include "stewart/node/exit_code.h"
 
 namespace fs = std::filesystem;

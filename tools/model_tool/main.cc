@@ -41,7 +41,8 @@ int main(int argc, char** argv) {
 
   auto run = [&](const nlohmann::json& in) {
     const stewart::ModelQuery query = stewart::ParseModelQuery(in, config.home_pose);
-    std::cout << stewart::EvaluateModelQuery(config.platform, query, &config.actuators).dump(indent) << "\n";
+    std::cout << stewart::EvaluateModelQuery(config.platform, query, &config.actuators).dump(indent)
+              << "\n";
   };
 
   if (!from_stdin) {

@@ -19,7 +19,6 @@ struct SensorConfig {
   unsigned seed = 0;
 };
 
-
 /// Leg-length step of the potentiometer ADC (m): codes 0 .. 2^bits - 1 span
 /// the stroke, so stroke / (2^bits - 1); 0 when leg_adc_bits = 0 (no
 /// quantisation). The simulator quantises with it, the estimator models it.

@@ -18,5 +18,4 @@ struct PlantSimConfig {
   Vector6d initial_velocity = Vector6d::Zero();
 };
 
-
 }  // namespace stewart
