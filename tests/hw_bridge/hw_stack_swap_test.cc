@@ -18,6 +18,7 @@
 #include <string>
 
 #include "stewart/config/config_loader.h"
+#include "stewart/config/default_config.h"
 #include "stewart/test_support/recorded_run.h"
 #include "stewart/test_support/stack_launch.h"
 
@@ -32,10 +33,10 @@ constexpr double kMinMaxX = 0.05;   // x reached by then (m)
 /// The shipped config with this test's device ports, so it never meets
 /// another bridge or emulator on the default ones. (The shipped bridge has no
 /// force dead zone: a 0.5 N one stalled this scenario, docs/hardware.md.)
-void WriteConfig(const std::string& path) {
+void WriteConfig(const std::string& path, int device_port = kDevicePort) {
   YAML::Node root = YAML::LoadFile(DefaultConfigPath());
-  root["hw_bridge"]["device_port"] = kDevicePort;
-  root["hw_bridge"]["local_port"] = kDevicePort + 1;
+  root["hw_bridge"]["device_port"] = device_port;
+  root["hw_bridge"]["local_port"] = device_port + 1;
   std::ofstream out(path);
   out << root << "\n";
 }
@@ -45,19 +46,27 @@ class HwBridgeStackSwap : public WithRunFolder<::testing::Test> {
   HwBridgeStackSwap() : WithRunFolder("stewart_hw_swap_test") {}
 };
 
-TEST_F(HwBridgeStackSwap, PaperScenarioAgainstTheEmulatorHoldsTheLimits) {
-  const std::string config_path = run_folder_ + "/platform.yaml";
-  const std::string run_dir = run_folder_ + "/run";
-  const std::string output_path = run_folder_ + "/launch.out";
-  WriteConfig(config_path);
+struct SwapCase {
+  int lcm_port;
+  int device_port;
+  bool p16p_legs;  // config/overlays/p16p.yaml: the emulator's legs are DC motors on the duty
+};
+
+void RunPaperAgainstTheEmulator(const std::string& run_folder, const SwapCase& c) {
+  const std::string config_path = run_folder + "/platform.yaml";
+  const std::string run_dir = run_folder + "/run";
+  const std::string output_path = run_folder + "/launch.out";
+  WriteConfig(config_path, c.device_port);
   const LaunchResult launch = RunLauncher(
       "--no-build --plant hw --device-emulator --scenario paper --config " +
-          ShellQuote(config_path) + " --duration " + FormatNumber(kDurationS) + " --no-report",
-      kLcmPort, run_dir, output_path);
+          ShellQuote(config_path) + " --duration " + FormatNumber(kDurationS) + " --no-report" +
+          (c.p16p_legs ? " --overlay " + ShellQuote(DcMotorOverlayPath()) : ""),
+      c.lcm_port, run_dir, output_path);
   ASSERT_EQ(launch.exit_code, 0) << LaunchFailure(launch);
 
   const StackConfig config = LoadStackConfig(run_dir + "/config.yaml");
-  ASSERT_EQ(config.hw_bridge.device_port, kDevicePort);
+  ASSERT_EQ(config.hw_bridge.device_port, c.device_port);
+  ASSERT_EQ(config.actuators.kind == ActuatorKind::kDcMotor, c.p16p_legs);
   const RecordedRun s = ReadRecordedRun(run_dir + "/log.lcm", config);
   ASSERT_NE(s.Worst(), nullptr);
   std::printf(
@@ -77,6 +86,17 @@ TEST_F(HwBridgeStackSwap, PaperScenarioAgainstTheEmulatorHoldsTheLimits) {
   EXPECT_EQ(s.diverged_estimates, 0);
   EXPECT_GE(s.max_x, kMinMaxX);
   ExpectWithinLimits(s);
+}
+
+TEST_F(HwBridgeStackSwap, PaperScenarioAgainstTheEmulatorHoldsTheLimits) {
+  RunPaperAgainstTheEmulator(run_folder_, SwapCase{kLcmPort, kDevicePort, false});
+}
+
+// The prototype's legs: the bridge turns the filter's force into a duty by
+// actuators.motor's map, the emulator's motors (back-EMF, rotor inertia,
+// dead band, self-locking screws) move the legs.
+TEST_F(HwBridgeStackSwap, PaperScenarioAgainstTheEmulatorWithP16pLegsHoldsTheLimits) {
+  RunPaperAgainstTheEmulator(run_folder_, SwapCase{kLcmPort + 1, kDevicePort + 2, true});
 }
 
 }  // namespace

@@ -18,6 +18,7 @@
 #include <string>
 
 #include "stewart/config/config_loader.h"
+#include "stewart/config/default_config.h"
 #include "stewart/model/types.h"
 #include "stewart/test_support/recorded_run.h"
 #include "stewart/test_support/stack_launch.h"
@@ -30,14 +31,21 @@ struct StackCase {
   int lcm_port;       // this file's private ports: 7820-7829
   double duration_s;  // simulated seconds
   double min_max_x;   // the platform must reach this x (m): the run challenged the limits
+  bool p16p_legs = false;  // with config/overlays/p16p.yaml: the prototype's DC-motor legs
 };
 
 // paper: x moves to 0.1 m at the 0.015 m/s velocity limit during 0-10 s, then
 // y starts. beyond-limits: x steps to 0.14 m, beyond the 0.11 m limit.
-const StackCase kCases[] = {{"paper", 7820, 12.0, 0.09}, {"beyond-limits", 7821, 12.0, 0.10}};
+// With the P-16P legs the platform cruises more slowly (the motors' back-EMF
+// and the 100 N box): ~0.085 m by 12 s.
+const StackCase kCases[] = {{"paper", 7820, 12.0, 0.09},
+                            {"beyond-limits", 7821, 12.0, 0.10},
+                            {"paper", 7823, 12.0, 0.08, true},
+                            {"beyond-limits", 7824, 12.0, 0.09, true}};
 
 void PrintTo(const StackCase& c, std::ostream* os) {
-  *os << c.scenario << " (" << c.duration_s << " s, LCM port " << c.lcm_port << ")";
+  *os << c.scenario << (c.p16p_legs ? " with P-16P legs" : "") << " (" << c.duration_s
+      << " s, LCM port " << c.lcm_port << ")";
 }
 
 class StackLockstep : public WithRunFolder<::testing::TestWithParam<StackCase>> {
@@ -51,12 +59,14 @@ TEST_P(StackLockstep, LimitsHoldOnGroundTruth) {
   const std::string output_path = run_folder_ + "/launch.out";
   const LaunchResult launch =
       RunLauncher("--scenario " + ShellQuote(c.scenario) + " --duration " +
-                      FormatNumber(c.duration_s) + " --no-build --no-report",
+                      FormatNumber(c.duration_s) + " --no-build --no-report" +
+                      (c.p16p_legs ? " --overlay " + ShellQuote(DcMotorOverlayPath()) : ""),
                   c.lcm_port, run_dir, output_path);
   ASSERT_EQ(launch.exit_code, 0) << LaunchFailure(launch);
 
   // The limits the run used: the launcher keeps its config beside the log.
   const StackConfig config = LoadStackConfig(run_dir + "/config.yaml");
+  ASSERT_EQ(config.actuators.kind == ActuatorKind::kDcMotor, c.p16p_legs);
   ASSERT_FALSE(config.safety.position_limits.empty());
   ASSERT_FALSE(config.safety.velocity_limits.empty());
   const RecordedRun s = ReadRecordedRun(run_dir + "/log.lcm", config);
@@ -87,7 +97,7 @@ INSTANTIATE_TEST_SUITE_P(Scenarios, StackLockstep, ::testing::ValuesIn(kCases),
                            std::string name = param_info.param.scenario;
                            for (char& ch : name)
                              if (ch == '-') ch = '_';
-                           return name;
+                           return param_info.param.p16p_legs ? name + "_p16p" : name;
                          });
 
 }  // namespace
