@@ -15,16 +15,27 @@ namespace stewart::safety {
 namespace {
 
 // A fixed set of states around home with nominal forces that make the filter
-// act often (every case occurs), cycled through by every benchmark.
+// act often (every case occurs), cycled through by every benchmark. The
+// accelerations are scaled so that M qdd spreads as on the platform without
+// actuator rotors (2 m/s^2 there): with the DC-motor legs' reflected mass
+// (config/overlays/p16p.yaml, STEWART_CONFIG) M is ~100 times larger, and
+// the unscaled set would ask every leg for kilonewtons.
 struct Sample {
   Vector6d q, qd, f_des;
   DynamicsTerms terms;
 };
-const std::vector<Sample>& Samples() {
-  static const std::vector<Sample> samples = [] {
-    std::vector<Sample> s;
+std::vector<Sample> MakeSamples(double accel_scale) {
+  std::vector<Sample> s;
+  {
     std::mt19937 rng(5);
     std::normal_distribution<double> n;
+    const PlatformParams& platform = DefaultStackConfig().platform;
+    PlatformParams without_rotors = platform;
+    without_rotors.leg.actuator_reflected_mass_kg = 0.0;
+    const Vector6d home = DefaultStackConfig().home_pose;
+    const double accel_std_mps2 = 2.0 *
+                                  EvaluateDynamics(without_rotors, home, Vector6d::Zero()).M(0, 0) /
+                                  EvaluateDynamics(platform, home, Vector6d::Zero()).M(0, 0);
     for (int i = 0; i < 256; ++i) {
       Sample x;
       x.q = DefaultStackConfig().home_pose;
@@ -32,12 +43,22 @@ const std::vector<Sample>& Samples() {
       for (int j = 0; j < 6; ++j) x.qd(j) = 0.008 * n(rng);
       x.terms = EvaluateDynamics(DefaultStackConfig().platform, x.q, x.qd);
       Vector6d qdd;
-      for (int j = 0; j < 6; ++j) qdd(j) = 2.0 * n(rng);
+      for (int j = 0; j < 6; ++j) qdd(j) = accel_scale * accel_std_mps2 * n(rng);
       x.f_des = InverseDynamics(x.terms, qdd);
       s.push_back(x);
     }
-    return s;
-  }();
+  }
+  return s;
+}
+
+const std::vector<Sample>& Samples() {
+  static const std::vector<Sample> samples = MakeSamples(1.0);
+  return samples;
+}
+
+// Accelerations 20 times larger: many steps reach the force limits.
+const std::vector<Sample>& HardSamples() {
+  static const std::vector<Sample> samples = MakeSamples(20.0);
   return samples;
 }
 
@@ -129,6 +150,33 @@ void BM_ForceLimitedFullStep(benchmark::State& state) {
   RunFullStep(state, s);
 }
 BENCHMARK(BM_ForceLimitedFullStep);
+
+// (d) on states whose unlimited optimum leaves the box only (from a set with
+// 20 times the accelerations): the steps that run the active set (the others
+// take the closed form and stop), the per-step worst case of the
+// force-limited filter.
+void BM_ForceLimitedFullStepBoxActiveOnly(benchmark::State& state) {
+  SafetyConfig s = DefaultStackConfig().safety;
+  s.force_limits_enabled = true;
+  SafetyFilter filter(DefaultStackConfig().platform, s, DefaultStackConfig().actuators);
+  std::vector<const Sample*> limited;
+  SafetyDiagnostics d;
+  for (const Sample& x : HardSamples()) {
+    filter.Step(x.q, x.qd, x.f_des, &d);
+    if (d.flags & kFlagForceLimited) limited.push_back(&x);
+  }
+  if (limited.empty()) {
+    state.SkipWithError("no state of the set reaches the force limits");
+    return;
+  }
+  size_t i = 0;
+  for (auto _ : state) {
+    const Sample& x = *limited[i++ % limited.size()];
+    benchmark::DoNotOptimize(filter.Step(x.q, x.qd, x.f_des, &d));
+  }
+  state.counters["states"] = static_cast<double>(limited.size());
+}
+BENCHMARK(BM_ForceLimitedFullStepBoxActiveOnly);
 
 // The un-composed QP (every barrier its own row, dual active set), full
 // step, unlimited and force-limited: what dropping the LSE costs per step.

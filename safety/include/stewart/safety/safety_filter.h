@@ -149,6 +149,8 @@ class SafetyFilter {
   /// multipliers (lower, upper per leg; nullptr when none were posed or the
   /// solver gives none), d->mu_force and kFlagForceLimited.
   static void ReportQpSolution(const double* force_limit_mu, SafetyDiagnostics* d);
+  // Flags and correction norm of a finished step.
+  static void FinishStep(const Vector6d& f_des, SafetyDiagnostics* d);
   /// The multiplier of a condition posed as a unit-normal row (`row` -1: not posed).
   static double ConditionMultiplier(const double* row_mu, int row, double norm) {
     return row >= 0 ? row_mu[row] / norm : 0.0;
