@@ -60,6 +60,9 @@ bool SafetyProcess::OnState(const StateSample& state, SafetyOutput* out) {
   has_pending_nominal_ = has_pending_nominal_ && !pending_for_this &&
                          pending_nominal_.sample_utime > state.sample_utime;
   if (!StateUsable(state)) {
+    // The controller answers usable states only: after this gap it gets
+    // stale_age_s from the next usable state, as at start-up.
+    first_usable_state_utime_ = -1;
     if (state.sample_utime <= last_published_sample_utime_) return false;
     *out = Fallback(state, kCommandInvalidInput);
     return true;
@@ -67,9 +70,11 @@ bool SafetyProcess::OnState(const StateSample& state, SafetyOutput* out) {
   // Judged on the nominals derived from earlier samples only: whether this
   // sample's own nominal overtook the state (multicast order) must not change
   // the answer, so a log or an in-process run replays the same commands.
-  // Until the first nominal, the watchdog counts from the first usable
-  // state: the controller gets stale_age_s to answer it, however late its
-  // answer arrives relative to the next states.
+  // From the first usable state after unusable ones (start-up, an estimator
+  // restart) the watchdog counts from that state: the controller gets
+  // stale_age_s to answer it, however late its answer arrives relative to
+  // the next states (else whether the answer beat the next state over
+  // multicast would decide between filter and fallback).
   if (first_usable_state_utime_ < 0) first_usable_state_utime_ = state.utime;
   const int64_t newest_earlier_nominal =
       pending_for_this ? newest_nominal_before_pending_ : newest_nominal_sample_utime_;

@@ -75,5 +75,74 @@ TEST(SafetyProcessOrder, StateOrNominalFirstGiveTheSameCommands) {
   }
 }
 
+// After an estimator restart (states not usable for longer than the stale
+// age, no nominals: the controller answers usable states only) the first
+// usable state's nominal is filtered, whether the controller's answers come
+// before the next state or after it: which one wins the multicast race must
+// not decide between filter and fallback (it did, 1 run in 6 of the
+// in-process vs LCM lockstep comparison under load).
+std::vector<Answer> AnswersAcrossARestart(bool answers_late) {
+  const StackConfig& c = DefaultConfig();
+  HealthCounters counters("safety restart order test");
+  SafetyProcess process(c.platform, c.safety, c.actuators, nullptr, &counters);
+  const Vector6d q = c.home_pose;
+  const Vector6d f_des = HoverForce(q) + Vector6d::Constant(0.5);
+  constexpr int kUsableBefore = 5, kUnusable = 30, kUsableAfter = 6;
+  static_assert(kUnusable * 1000 > 20000, "longer than the shipped stale age");
+  std::vector<Answer> answers;
+  SafetyOutput out;
+  const auto keep = [&](bool answered) {
+    if (answered)
+      answers.push_back({out.command.sample_utime, out.command.force_n, out.command.flags});
+  };
+  const auto nominal_of = [&](int64_t sample_utime) {
+    ForceCommand nominal;
+    nominal.utime = nominal.sample_utime = sample_utime;
+    nominal.force_n = f_des;
+    return nominal;
+  };
+  bool late_nominal = false;
+  int64_t late_sample_utime = 0;
+  for (int k = 0; k < kUsableBefore + kUnusable + kUsableAfter; ++k) {
+    StateSample state;
+    state.utime = state.sample_utime = 1'000'000 + 1000 * static_cast<int64_t>(k);
+    state.q = q;
+    const bool usable = k < kUsableBefore || k >= kUsableBefore + kUnusable;
+    state.status = usable ? kStateValid : kStateInitializing;
+    keep(process.OnState(state, &out));
+    if (late_nominal) {  // the answer to the previous state, overtaken by this one
+      keep(process.OnNominal(nominal_of(late_sample_utime), &out));
+      late_nominal = false;
+    }
+    if (!usable) continue;
+    if (answers_late && k >= kUsableBefore + kUnusable) {
+      late_nominal = true;
+      late_sample_utime = state.sample_utime;
+    } else {
+      keep(process.OnNominal(nominal_of(state.sample_utime), &out));
+    }
+  }
+  if (late_nominal) keep(process.OnNominal(nominal_of(late_sample_utime), &out));
+  return answers;
+}
+
+TEST(SafetyProcessOrder, AfterAnEstimatorRestartLateAnswersGiveTheSameCommands) {
+  const std::vector<Answer> prompt = AnswersAcrossARestart(false);
+  const std::vector<Answer> late = AnswersAcrossARestart(true);
+  ASSERT_EQ(prompt.size(), 41u);  // one answer per sample
+  ASSERT_EQ(late.size(), prompt.size());
+  for (size_t i = 0; i < prompt.size(); ++i) {
+    EXPECT_EQ(late[i].sample_utime, prompt[i].sample_utime) << i;
+    EXPECT_EQ(late[i].force_n, prompt[i].force_n) << i;
+    EXPECT_EQ(late[i].flags, prompt[i].flags) << i;
+  }
+  // The unusable states got the fallback, the first usable one after them
+  // its filtered nominal.
+  EXPECT_TRUE(prompt[5].flags & kCommandFallback);
+  EXPECT_TRUE(prompt[34].flags & kCommandFallback);
+  EXPECT_FALSE(prompt[35].flags & kCommandFallback);
+  EXPECT_FALSE(prompt[36].flags & kCommandFallback);
+}
+
 }  // namespace
 }  // namespace stewart::safety::test

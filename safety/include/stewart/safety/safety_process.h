@@ -76,7 +76,8 @@ class SafetyProcess {
   bool has_pending_nominal_ = false;
   /// newest_nominal_sample_utime_ before the pending nominal arrived.
   int64_t newest_nominal_before_pending_ = -1;
-  int64_t first_usable_state_utime_ = -1;  ///< utime of the first usable state
+  int64_t first_usable_state_utime_ =
+      -1;  ///< first usable state since start or the last unusable one
   int64_t seq_ = 0;
   SafetyDiagnostics diagnostics_{};
 };
