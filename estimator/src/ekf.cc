@@ -1,5 +1,6 @@
 #include "stewart/estimator/ekf.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "stewart/estimator/measurement_models.h"
@@ -13,6 +14,11 @@ namespace {
 constexpr double kUsToS = 1e-6;
 // An estimate this uncertain is no estimate: restart instead of publishing it.
 constexpr double kMaxPositionStdM = 0.05;
+
+double HoldTimeConstant(const ActuatorConfig& actuators) {
+  if (actuators.kind != ActuatorKind::kDcMotor) return 0.0;  // never used
+  return std::max(actuators.motor.reflected_mass_kg / ModelLegDampingNspm(actuators), 2e-3);
+}
 
 // Discrete white-noise acceleration (one sample of constant acceleration with
 // std sigma) on the (q_i, qd_i) pair of axis i.
@@ -118,6 +124,7 @@ Ekf::Ekf(const PlatformParams& params, const ActuatorConfig& actuators, const Se
     : params_(params),
       actuators_(actuators),
       leg_damping_nspm_(ModelLegDampingNspm(actuators)),
+      hold_time_constant_s_(HoldTimeConstant(actuators)),
       config_(config),
       home_pose_(home_pose),
       imu_offset_m_(sensors.imu_offset_in_P_m) {
@@ -238,14 +245,31 @@ void Ekf::Predict(double dt_s, int64_t utime, const EulerAngleTrig& trig, uint32
   const bool command_fresh =
       command != nullptr &&
       utime - command->utime <= static_cast<int64_t>(config_.command_timeout_s / kUsToS);
-  const bool use_dynamics =
-      config_.process_model == EstimatorProcessModel::kDynamics && command_fresh;
+  const bool dynamics_model = config_.process_model == EstimatorProcessModel::kDynamics;
+  // DC-motor legs without drive (before the first command, after the drive
+  // timed out, or a zero command: the safe stop) are held by their
+  // self-locking screws, which the dynamics model does not know: with F = 0
+  // it would predict the platform sinking against the legs' damping and
+  // explain the legs' stillness as model error d, which the controller and
+  // the filter then apply as soon as the drive returns.
+  const bool legs_held = dynamics_model && actuators_.kind == ActuatorKind::kDcMotor &&
+                         (!command_fresh || command->force_n.isZero());
+  const bool use_dynamics = dynamics_model && command_fresh && !legs_held;
   double sigma_lin = config_.process_accel_std_mps2;
   double sigma_ang = config_.process_angaccel_std_radps2;
   if (use_dynamics) {
     DynamicsAccelerationJacobians(params_, leg_damping_nspm_, q, trig, qd, command->force_n,
                                   x_.segment<6>(kEkfDisturbance), &qdd_, &dqdd_dq_, &dqdd_dqd_,
                                   &m_inv_);
+    sigma_lin = config_.dynamics_accel_std_mps2;
+    sigma_ang = config_.dynamics_angaccel_std_radps2;
+  } else if (legs_held) {
+    // Held: the motion dies out with the legs' time constant; d takes no part.
+    *events |= kEventLegsHeld;
+    qdd_ = -qd / hold_time_constant_s_;
+    dqdd_dq_.setZero();
+    dqdd_dqd_ = Matrix6d::Identity() * (-1.0 / hold_time_constant_s_);
+    m_inv_.setZero();
     sigma_lin = config_.dynamics_accel_std_mps2;
     sigma_ang = config_.dynamics_angaccel_std_radps2;
   } else {
@@ -268,7 +292,7 @@ void Ekf::Predict(double dt_s, int64_t utime, const EulerAngleTrig& trig, uint32
   //   P'_vv = T_vv + T_v,(q,qd,d) W^T,  P'_(d,b)v = P_(d,b)v + U_(d,b)^T
   // and the upper blocks as the mirror of the lower ones.
   const auto rows_v = P_.middleRows<6>(kEkfQd);
-  if (use_dynamics) {
+  if (use_dynamics || legs_held) {
     Eigen::Matrix<double, 6, 18> w;
     w << dt_s * dqdd_dq_, dt_s * dqdd_dqd_, dt_s * m_inv_;
     Eigen::Matrix<double, 6, kEkfStateSize + 1> u;

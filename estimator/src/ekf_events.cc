@@ -36,6 +36,8 @@ const char* EkfEventName(EkfEvent event) {
       return "init_fk_failed";
     case kEventDisturbanceJump:
       return "disturbance_jumps";
+    case kEventLegsHeld:
+      return "predict_legs_held";
   }
   return "unknown";
 }

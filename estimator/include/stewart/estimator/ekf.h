@@ -62,6 +62,9 @@ class Ekf {
   PlatformParams params_;
   ActuatorConfig actuators_;
   double leg_damping_nspm_;  // N s/m: screw friction + back-EMF (ModelLegDampingNspm)
+  // s: how fast held DC-motor legs stop, reflected mass / back-EMF damping
+  // (at least 2 ms: a massless rotor stops within a sample or two).
+  double hold_time_constant_s_;
   EstimatorConfig config_;
   Vector6d home_pose_;
   Vector3d imu_offset_m_;

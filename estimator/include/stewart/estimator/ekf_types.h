@@ -67,7 +67,10 @@ enum EkfEvent : uint32_t {
   /// gate: d's uncertainty was re-opened (a push, a payload change) and the
   /// sample used again.
   kEventDisturbanceJump = 1u << 15,
-  kEventLast = kEventDisturbanceJump,
+  /// DC-motor legs without drive (no fresh command, or an all-zero one):
+  /// predicted as held by their self-locking screws, not by the dynamics.
+  kEventLegsHeld = 1u << 16,
+  kEventLast = kEventLegsHeld,
 };
 
 /// Short snake_case name of one event bit (health counter names).
