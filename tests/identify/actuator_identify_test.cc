@@ -10,6 +10,7 @@
 #include "stewart/identify/actuator_fit.h"
 #include "stewart/identify/actuator_overlay.h"
 #include "stewart/identify/actuator_procedure.h"
+#include "stewart/identify/emulator_device.h"
 #include "stewart/identify/plant_device.h"
 #include "stewart/model/dc_motor.h"
 
@@ -41,10 +42,8 @@ ActuatorProcedureOptions ProcedureOptions(const StackConfig& c) {
   return o;
 }
 
-TEST(ActuatorIdentification, RecoversOtherMotorsInSimulation) {
+void Identify(ActuatorDevice& device, const PlantTruth& truth) {
   const StackConfig& c = Config();
-  const PlantTruth truth = OtherMotors();
-  PlantDevice device(c, truth);
   const ActuatorRecord record =
       RunActuatorProcedure(&device, ProcedureOptions(c),
                            [](const std::string& line) { std::printf("%s\n", line.c_str()); });
@@ -80,6 +79,23 @@ TEST(ActuatorIdentification, RecoversOtherMotorsInSimulation) {
         leg.leg, leg.samples, leg.excursions, leg.iterations, 1e6 * leg.residual_rms_m,
         leg.correlation_inflation, leg.mean_load_n);
   }
+}
+
+TEST(ActuatorIdentification, RecoversOtherMotorsInSimulation) {
+  const PlantTruth truth = OtherMotors();
+  PlantDevice device(Config(), truth);
+  Identify(device, truth);
+}
+
+TEST(ActuatorIdentification, RecoversOtherMotorsThroughTheEmulator) {
+  const StackConfig& c = Config();
+  const PlantTruth truth = OtherMotors();
+  hw::BringupOptions bringup;
+  bringup.enabled = true;
+  bringup.guard = hw::DefaultBringupGuard(c.platform.leg_min_length_m, c.platform.leg_max_length_m,
+                                          c.safety.leg_stroke.margin_m, c.actuators.motor);
+  EmulatorDevice device(c, truth, bringup);
+  Identify(device, truth);
 }
 
 }  // namespace

@@ -40,5 +40,4 @@ struct HwBridgeConfig {
   Vector6d drive_sign = Vector6d::Ones();  ///< +1 or -1 per leg
 };
 
-
 }  // namespace stewart
