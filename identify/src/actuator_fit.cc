@@ -20,6 +20,9 @@ namespace {
 
 enum { kAlpha, kBeta, kGamma, kKappa, kNumTheta };
 
+// Larger relative sigma of gamma: the fit refuses (see FitLeg).
+constexpr double kMaxScaleSigma = 0.25;
+
 std::string Fmt(const char* format, double value) {
   char text[64];
   std::snprintf(text, sizeof text, format, value);
@@ -359,6 +362,16 @@ LegFit FitLeg(const PlatformParams& model, const ActuatorConfig& config, const L
   if (!(fit.theta(kAlpha) > 0.0) || !(fit.theta(kGamma) > 0.0)) {
     throw IdentificationError(LegName(rec.leg) + ": unphysical fit (the leg's speed does not " +
                               "grow with the duty, or its damping is not positive)");
+  }
+  // The absolute force scale rests on the leg's load alone: without enough
+  // of it gamma (1 / b) is not determined, and every force with it.
+  const double gamma_relative_sigma = std::sqrt(fit.covariance(kGamma, kGamma)) / fit.theta(kGamma);
+  if (!(gamma_relative_sigma < kMaxScaleSigma)) {
+    throw IdentificationError(
+        LegName(rec.leg) + ": the force scale is not determined (leg damping +- " +
+        Fmt("%.0f", 100.0 * gamma_relative_sigma) + " %): the leg's load from the platform's " +
+        "weight, " + Fmt("%.3g", fit.mean_load_n) + " N, is too small against the pot's noise " +
+        "to tell extending from retracting speeds (--repeats, or a known mass on the platform)");
   }
   // The ramps: where the leg started, and where the line says it should.
   std::size_t ramp_index = 0;

@@ -42,9 +42,22 @@ class Runner {
     if (progress_) progress_(line);
   }
   std::string LegName() const { return "leg " + std::to_string(leg_); }
-  double SquareWave(const DutyLevels& levels, double elapsed_s) const {
-    const auto half = static_cast<long>(std::floor(elapsed_s / o_.half_period_s));
-    return half % 2 == 0 ? levels.hi : levels.lo;
+  // Half periods vary between 0.75 and 1.25 times half_period_s (a
+  // golden-ratio sequence, another stretch of it in every excursion): the
+  // level changes fall at other leg lengths each time, so a reading error
+  // that depends on the length (ADC steps, the pot's track) does not meet
+  // them the same way in every excursion and averages out over them. With
+  // one fixed period it did not: the emulator's two ADCs biased the rotor
+  // mass by +5 %, more with more repeats.
+  double SquareWave(const DutyLevels& levels, double elapsed_s, int excursion) const {
+    constexpr double kGolden = 0.6180339887498949;
+    double start_s = 0.0;
+    for (long n = 0;; ++n) {
+      const double phase = static_cast<double>(n + 7L * excursion) * kGolden;
+      const double half_s = o_.half_period_s * (0.75 + 0.5 * (phase - std::floor(phase)));
+      if (elapsed_s < start_s + half_s) return n % 2 == 0 ? levels.hi : levels.lo;
+      start_s += half_s;
+    }
   }
 
   ActuatorDevice* device_;
@@ -221,19 +234,26 @@ LegTestRecord Runner::RunLeg(int leg) {
   }
 
   // Excursions: out by excursion_m, back home.
+  int excursion = 0;
   for (int r = 0; r < o_.repeats; ++r) {
     for (std::size_t j = 0; j < o_.levels.size(); ++j) {
       const DutyLevels levels = o_.levels[j];
       const int sign = j % 2 == 0 ? 1 : -1;
+      const int out = excursion++;
       RunStep(
           StepKind::kExcursion, sign, o_.move_timeout_s,
-          [this, sign, levels](double elapsed_s) { return sign * SquareWave(levels, elapsed_s); },
+          [this, sign, levels, out](double elapsed_s) {
+            return sign * SquareWave(levels, elapsed_s, out);
+          },
           [this, sign](double, double moved, double) { return sign * moved >= o_.excursion_m; });
       record.steps.back().levels = levels;
       Rest();
+      const int back = excursion++;
       RunStep(
           StepKind::kExcursion, -sign, o_.move_timeout_s,
-          [this, sign, levels](double elapsed_s) { return -sign * SquareWave(levels, elapsed_s); },
+          [this, sign, levels, back](double elapsed_s) {
+            return -sign * SquareWave(levels, elapsed_s, back);
+          },
           [sign, home](double, double, double length) { return -sign * (length - home) >= 0.0; });
       record.steps.back().levels = levels;
       Rest();

@@ -12,7 +12,8 @@
 //      moved ramp_distance_m, extending, then retracting: the duty at which
 //      it starts to move;
 //   4. excursions: per pair of levels (hi, lo), a square wave of the duty
-//      between them (half period half_period_s) in one direction until the
+//      between them (half periods 0.75-1.25 half_period_s, irregular) in one
+//      direction until the
 //      leg has moved excursion_m, a rest, and the same back to its home
 //      length; pairs alternate between starting outwards and inwards, so the
 //      leg stays within +-excursion_m of home.
