@@ -95,9 +95,17 @@ void HwBridge::UpdateBringup(const SensorFrame& frame, const SensorSample& sampl
   if (tripped != 0) tick_frame_due_ = true;
 
   applied_.sample_utime = sample.utime;
-  applied_.duty = drive_map_.Duty(frame.applied_drive);
   applied_.device_watchdog = (frame.status & kStatusWatchdog) != 0;
   applied_.guard_mask = static_cast<uint8_t>(guard_.tripped_mask() | guard_.limited_mask());
+  // Since when the device has applied this drive: a frame that repeats the
+  // drive in force (a keep-alive, two commands in a row after the program
+  // stalled) changes nothing, so the time stays that of the frame that
+  // changed it, not of the latest frame.
+  const bool changed = !have_applied_ || frame.applied_drive != applied_drive_;
+  applied_drive_ = frame.applied_drive;
+  have_applied_ = true;
+  if (!changed) return;
+  applied_.duty = drive_map_.Duty(frame.applied_drive);
   if (frame.last_command_seq == 0) {
     applied_.since_utime = 0;  // nothing applied yet
   } else {

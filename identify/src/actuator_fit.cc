@@ -104,7 +104,11 @@ LegData Prepare(const PlatformParams& model, const LegTestRecord& rec, const Vec
     bool ended = false;
     for (++k; k < n; ++k) {
       const ActuatorSample& s = rec.samples[k];
-      if (s.applied_since_utime == since) continue;
+      // A new time with the same duty is no change (a device that reports
+      // the latest frame's arrival): the change was at the earlier time.
+      if (s.applied_since_utime == since || (duty_at(k) == duty_at(k - 1) && duty_at(k) != 0.0)) {
+        continue;
+      }
       since = s.applied_since_utime;
       if (duty_at(k) == 0.0) {
         seg.t_off_s = seconds(since);

@@ -183,6 +183,8 @@ class HwBridge {
   BringupOptions bringup_;
   LegGuard guard_;
   AppliedDuty applied_;
+  DriveArray applied_drive_{};  // the device's applied drive, latest frame
+  bool have_applied_ = false;
   uint32_t sent_watchdog_us_ = 0;
   uint32_t next_command_seq_ = 1;
   DriveReason last_reason_ = DriveReason::kMissing;

@@ -32,9 +32,10 @@ LegGuardLimits DefaultBringupGuard(double min_length_m, double max_length_m, dou
 /// What the device applied, from its sensor frame (the bring-up echo).
 struct AppliedDuty {
   int64_t sample_utime = 0;  ///< the sensor sample that reported it
-  /// Stack time from which the device applies `duty`: the sample time minus
-  /// the age the device reports for the command frame in force (or the
-  /// instant its watchdog expired).
+  /// Stack time from which the device has applied `duty`: when the frame
+  /// that changed the drive arrived (the sample time minus the age the
+  /// device reports for it), or the instant the watchdog cut it; frames that
+  /// repeat the drive in force do not move it.
   int64_t since_utime = 0;
   Vector6d duty = Vector6d::Zero();  ///< per leg, positive extends
   uint8_t guard_mask = 0;            ///< legs the bridge's guard holds at zero duty
