@@ -40,4 +40,5 @@ struct HwBridgeConfig {
   Vector6d drive_sign = Vector6d::Ones();  ///< +1 or -1 per leg
 };
 
+
 }  // namespace stewart
