@@ -21,6 +21,7 @@
 #include "stewart/identify/plant_device.h"
 #include "stewart/node/exit_code.h"
 #include "stewart/node/lcm_handle.h"
+#include "stewart/node/stop_signal.h"
 
 namespace fs = std::filesystem;
 
@@ -122,6 +123,9 @@ ActuatorRecord RunOverLcm(const StackConfig& config, const ActuatorModeOptions& 
   }
   spdlog::info("hw: LCM {}, device UDP {} / bridge {}, process logs in {}", url, device_port,
                local_port, run_dir);
+  // A stop signal ends the procedure at the next sample (zero duty), and the
+  // processes are stopped below, not left running.
+  InstallStopSignalHandlers();
   const std::unique_ptr<lcm::LCM> lcm = MakeLcm(url);
   LcmActuatorDevice device(config, lcm.get(), o.sample_timeout_s);
   const auto stop_all = [&]() {

@@ -5,6 +5,7 @@
 #include "stewart/hw_bridge/bringup.h"
 #include "stewart/identify/inertial_fit.h"
 #include "stewart/node/eigen_msg.h"
+#include "stewart/node/stop_signal.h"
 
 namespace stewart::identify {
 
@@ -52,6 +53,9 @@ ActuatorSample LcmActuatorDevice::NextSample() {
   using Clock = std::chrono::steady_clock;
   const auto deadline = Clock::now() + std::chrono::duration<double>(timeout_s_);
   while (!ready_) {
+    // Interrupted (SIGINT, SIGTERM): the procedure sends zero duty and the
+    // tool stops the processes it started.
+    if (StopRequested()) throw IdentificationError("interrupted: zero duty sent");
     if (receiver_.HandleTimeout(5) < 0) throw IdentificationError("LCM receive error");
     if (ready_) break;
     if (Clock::now() > deadline) {
