@@ -26,17 +26,27 @@ int8_t HealthState(hw::LinkState state) {
 
 }  // namespace
 
-BridgeNode::BridgeNode(const StackConfig& config, lcm::LCM* lcm, hw::Transport* transport)
+BridgeNode::BridgeNode(const StackConfig& config, lcm::LCM* lcm, hw::Transport* transport,
+                       const hw::BringupOptions& bringup)
     : config_(config),
       lcm_(lcm),
       receiver_(config.lcm.url),
       transport_(transport),
       bridge_(config.hw_bridge, config.platform.leg_min_length_m,
               config.platform.leg_max_length_m - config.platform.leg_min_length_m,
-              config.actuators.force_limit_n),
+              config.actuators.force_limit_n, bringup),
       health_("hw_bridge", config.lcm.channels.health, config.lcm.health_rate_hz),
       reader_(transport->datagram()) {
+  // In bring-up the safe commands are still heard, to be rejected and
+  // counted (wrong_mode_command): a filter running then is a mistake to see.
   receiver_.Subscribe(config.lcm.channels.command_safe, &BridgeNode::OnCommand, this);
+  if (bringup.enabled) {
+    receiver_.Subscribe(
+        hw::BringupDutyChannel(config.lcm.channel_prefix, config.lcm.channel_suffix),
+        &BridgeNode::OnDutyCommand, this);
+    applied_channel_ =
+        hw::BringupAppliedChannel(config.lcm.channel_prefix, config.lcm.channel_suffix);
+  }
 }
 
 ExitCode BridgeNode::Run() {
@@ -88,7 +98,30 @@ void BridgeNode::OnFrame(const hw::DecodedFrame& frame) {
   lcm_->publish(config_.lcm.channels.sensors, &msg);
   health_.CountOut();
   health_.SetStackTime(sample.utime, sample.utime);
+  if (bridge_.bringup()) PublishApplied();
   if (bridge_.TickFrameDue()) SendCommand();
+}
+
+void BridgeNode::PublishApplied() {
+  const hw::AppliedDuty& applied = bridge_.applied();
+  duty_command_t msg{};
+  msg.utime = applied.since_utime;
+  msg.seq = applied_seq_++;
+  msg.sample_utime = applied.sample_utime;
+  ToArray(applied.duty, msg.duty);
+  msg.guard_mask = applied.guard_mask;
+  msg.flags =
+      (applied.device_watchdog ? duty_command_t::FLAG_DEVICE_WATCHDOG : 0) |
+      (bridge_.last_reason() != hw::DriveReason::kCommand ? duty_command_t::FLAG_ZERO_DRIVE : 0);
+  lcm_->publish(applied_channel_, &msg);
+}
+
+void BridgeNode::OnDutyCommand(const lcm::ReceiveBuffer*, const std::string&,
+                               const duty_command_t* msg) {
+  health_.CountIn();
+  const hw::CommandVerdict verdict = bridge_.OnDutyCommand(msg->utime, FromArray(msg->duty));
+  if (verdict != hw::CommandVerdict::kAccepted) health_.Reject(ToString(verdict));
+  if (hw::SendsAtOnce(verdict)) SendCommand();
 }
 
 void BridgeNode::OnCommand(const lcm::ReceiveBuffer*, const std::string&,
@@ -132,6 +165,12 @@ void BridgeNode::UpdateHealth() {
   health_.SetCounter("device_watchdog_samples", static_cast<int64_t>(c.device_watchdog_samples));
   health_.SetCounter("device_rx_corrupt", static_cast<int64_t>(c.device_rx_corrupt));
   health_.SetCounter("device_rx_lost", static_cast<int64_t>(c.device_rx_lost));
+  if (bridge_.bringup()) {
+    health_.SetCounter("bringup", 1);
+    health_.SetCounter("guard_trips", static_cast<int64_t>(c.guard_trips));
+    health_.SetCounter("guard_limited_frames", static_cast<int64_t>(c.guard_limited_frames));
+    health_.SetCounter("guard_mask", bridge_.applied().guard_mask);
+  }
 
   const hw::LinkHealth link = bridge_.Health(clock_.NowMicros(), transport_->description());
   health_.SetState(HealthState(link.state));

@@ -1,15 +1,19 @@
 #pragma once
 // The hw_bridge process's node: sensor frames from the device -> sensor_t on
 // channels.sensors (as plant_sim publishes them), force_command_t from
-// channels.command_safe -> command frames (docs/wire-protocol.md). What to do
-// with each frame, command and silence is hw::HwBridge's; this class only
-// moves bytes and messages and reports the heartbeat.
+// channels.command_safe -> command frames (docs/wire-protocol.md). In
+// bring-up mode (hw_bridge --bringup, hw_bridge/bringup.h) duty_command_t
+// from <prefix>BRINGUP_DUTY instead, and the device's applied duty echoed on
+// <prefix>BRINGUP_DUTY_APPLIED per sample. What to do with each frame,
+// command and silence is hw::HwBridge's; this class only moves bytes and
+// messages and reports the heartbeat.
 #include <array>
 #include <cstdint>
 #include <lcm/lcm-cpp.hpp>
 #include <string>
 
 #include "stewart/config/stack_config.h"
+#include "stewart/duty_command_t.hpp"
 #include "stewart/force_command_t.hpp"
 #include "stewart/hw_bridge/bridge.h"
 #include "stewart/hw_bridge/host_clock.h"
@@ -23,7 +27,8 @@ namespace stewart {
 
 class BridgeNode {
  public:
-  BridgeNode(const StackConfig& config, lcm::LCM* lcm, hw::Transport* transport);
+  BridgeNode(const StackConfig& config, lcm::LCM* lcm, hw::Transport* transport,
+             const hw::BringupOptions& bringup = {});
 
   /// Runs until a stop signal; kOk.
   ExitCode Run();
@@ -33,6 +38,9 @@ class BridgeNode {
   void OnFrame(const hw::DecodedFrame& frame);
   void OnCommand(const lcm::ReceiveBuffer* rbuf, const std::string& channel,
                  const force_command_t* msg);
+  void OnDutyCommand(const lcm::ReceiveBuffer* rbuf, const std::string& channel,
+                     const duty_command_t* msg);
+  void PublishApplied();
   void SendCommand();
   void UpdateHealth();
 
@@ -45,6 +53,8 @@ class BridgeNode {
   hw::HostClock clock_;
   hw::FrameReader reader_;
   std::array<uint8_t, 4096> rx_{};
+  std::string applied_channel_;  // bring-up only
+  int64_t applied_seq_ = 0;
 };
 
 }  // namespace stewart

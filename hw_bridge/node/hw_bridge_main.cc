@@ -1,6 +1,9 @@
 // hw_bridge: the only process that talks to the device. Publishes sensor_t
 // on channels.sensors (as plant_sim does) and turns force_command_t from
 // channels.command_safe into command frames (docs/wire-protocol.md).
+// --bringup: duty commands from <prefix>BRINGUP_DUTY instead, under the
+// bridge's own leg guard (docs/hardware.md, "Identify the actuators"); never
+// in normal operation.
 #include <spdlog/spdlog.h>
 
 #include <memory>
@@ -12,6 +15,9 @@
 int main(int argc, char** argv) {
   std::string transport, serial_device, device_host, local_host;
   int device_port = -1, local_port = -1, serial_baud = 0;
+  bool bringup = false;
+  double bringup_margin_m = -1.0, bringup_speed_cap_mps = -1.0;
+  stewart::hw::BringupOptions bringup_options;
   return stewart::NodeMain(
       argc, argv, {"hw_bridge", "hw_bridge: the device link behind the plant_sim LCM interface"},
       [&](CLI::App& app) {
@@ -24,6 +30,17 @@ int main(int argc, char** argv) {
         app.add_option("--device-port", device_port, "device UDP port");
         app.add_option("--local-host", local_host, "local IPv4 address to bind");
         app.add_option("--local-port", local_port, "local UDP port for sensor frames");
+        app.add_flag("--bringup", bringup,
+                     "bring-up mode: per-leg duty commands on <prefix>BRINGUP_DUTY under the "
+                     "bridge's leg guard, safe force commands rejected (never in operation)");
+        app.add_option("--bringup-margin", bringup_margin_m,
+                       "bring-up guard: end zone at either stroke end (m; default "
+                       "safety.leg_stroke.margin_m)")
+            ->check(CLI::PositiveNumber);
+        app.add_option("--bringup-speed-cap", bringup_speed_cap_mps,
+                       "bring-up guard: leg speed cap (m/s; default twice the full-duty speed "
+                       "of actuators.motor)")
+            ->check(CLI::PositiveNumber);
       },
       [&](stewart::StackConfig& config) -> std::optional<stewart::ExitCode> {
         stewart::HwBridgeConfig& hw = config.hw_bridge;
@@ -34,14 +51,31 @@ int main(int argc, char** argv) {
         if (device_port >= 0) hw.device_port = device_port;
         if (!local_host.empty()) hw.local_host = local_host;
         if (local_port >= 0) hw.local_port = local_port;
+        bringup_options.enabled = bringup;
+        bringup_options.guard = stewart::hw::DefaultBringupGuard(
+            config.platform.leg_min_length_m, config.platform.leg_max_length_m,
+            bringup_margin_m > 0.0 ? bringup_margin_m : config.safety.leg_stroke.margin_m,
+            config.actuators.motor);
+        if (bringup_speed_cap_mps > 0.0)
+          bringup_options.guard.speed_cap_mps = bringup_speed_cap_mps;
         return std::nullopt;
       },
       [&](const stewart::StackConfig& config, lcm::LCM* lcm) {
         const std::unique_ptr<stewart::hw::Transport> link =
             stewart::hw::OpenHostTransport(config.hw_bridge);
+        if (bringup_options.enabled) {
+          const stewart::hw::LegGuardLimits& g = bringup_options.guard;
+          spdlog::warn(
+              "hw_bridge: BRING-UP MODE: {} drives the legs' duty directly, no safety filter; "
+              "guard: {:.4f} m from the stroke ends, leg speed cap {:.4f} m/s; echo on {}",
+              stewart::hw::BringupDutyChannel(config.lcm.channel_prefix, config.lcm.channel_suffix),
+              g.margin_m, g.speed_cap_mps,
+              stewart::hw::BringupAppliedChannel(config.lcm.channel_prefix,
+                                                 config.lcm.channel_suffix));
+        }
         spdlog::info("hw_bridge: {} ; sensors -> {}, {} -> commands", link->description(),
                      config.lcm.channels.sensors, config.lcm.channels.command_safe);
-        stewart::BridgeNode node(config, lcm, link.get());
+        stewart::BridgeNode node(config, lcm, link.get(), bringup_options);
         return node.Run();
       });
 }

@@ -13,12 +13,14 @@ bool SendsAtOnce(CommandVerdict verdict) {
 }
 
 HwBridge::HwBridge(const HwBridgeConfig& hw, double min_length_m, double stroke_m,
-                   double force_limit_n)
+                   double force_limit_n, const BringupOptions& bringup)
     : hw_(hw),
       calibration_(hw, min_length_m, stroke_m),
       imu_(hw),
       drive_map_(hw, force_limit_n),
-      clock_(hw.clock_drift_ppm) {}
+      clock_(hw.clock_drift_ppm),
+      bringup_(bringup),
+      guard_(bringup.guard) {}
 
 bool HwBridge::OnSensorFrame(const SensorFrame& frame, int64_t host_rx_us, SensorSample* sample) {
   if (have_sample_) {
@@ -75,7 +77,42 @@ bool HwBridge::OnSensorFrame(const SensorFrame& frame, int64_t host_rx_us, Senso
   latest_sample_utime_ = utime;
   tick_frame_due_ = !sent_since_sample_;
   sent_since_sample_ = false;
+  if (bringup_.enabled) UpdateBringup(frame, *sample);
   return true;
+}
+
+void HwBridge::UpdateBringup(const SensorFrame& frame, const SensorSample& sample) {
+  uint8_t plausible = 0;
+  for (int i = 0; i < kNumLegs; ++i) {
+    if (calibration_.Plausible(i, frame.adc[static_cast<std::size_t>(i)])) {
+      plausible |= static_cast<uint8_t>(1U << i);
+    }
+  }
+  const uint8_t tripped = guard_.Update(sample.utime, sample.leg_length_m, plausible);
+  for (int i = 0; i < kNumLegs; ++i) counters_.guard_trips += (tripped >> i) & 1U;
+  // A leg just tripped: its zero drive goes out with this sample, not with
+  // the next command.
+  if (tripped != 0) tick_frame_due_ = true;
+
+  applied_.sample_utime = sample.utime;
+  applied_.device_watchdog = (frame.status & kStatusWatchdog) != 0;
+  applied_.guard_mask = static_cast<uint8_t>(guard_.tripped_mask() | guard_.limited_mask());
+  // Since when the device has applied this drive: a frame that repeats the
+  // drive in force (a keep-alive, two commands in a row after the program
+  // stalled) changes nothing, so the time stays that of the frame that
+  // changed it, not of the latest frame.
+  const bool changed = !have_applied_ || frame.applied_drive != applied_drive_;
+  applied_drive_ = frame.applied_drive;
+  have_applied_ = true;
+  if (!changed) return;
+  applied_.duty = drive_map_.Duty(frame.applied_drive);
+  if (frame.last_command_seq == 0) {
+    applied_.since_utime = 0;  // nothing applied yet
+  } else {
+    applied_.since_utime = sample.utime - static_cast<int64_t>(frame.command_age_us);
+    // The watchdog cut the frame's drive at its expiry, not at its arrival.
+    if (applied_.device_watchdog) applied_.since_utime += sent_watchdog_us_;
+  }
 }
 
 FrameOutcome HwBridge::OnFrame(const DecodedFrame& frame, int64_t host_rx_us,
@@ -85,8 +122,8 @@ FrameOutcome HwBridge::OnFrame(const DecodedFrame& frame, int64_t host_rx_us,
                                                          : FrameOutcome::kDropped;
 }
 
-CommandVerdict HwBridge::OnForceCommand(int64_t utime, const Vector6d& force_n) {
-  if (!force_n.allFinite()) {
+CommandVerdict HwBridge::AcceptCommand(int64_t utime, bool finite) {
+  if (!finite) {
     command_invalid_ = true;
     return CommandVerdict::kNonFinite;
   }
@@ -96,9 +133,22 @@ CommandVerdict HwBridge::OnForceCommand(int64_t utime, const Vector6d& force_n) 
   have_command_ = true;
   command_invalid_ = false;
   command_utime_ = utime;
-  command_force_n_ = force_n;
   ++counters_.commands_accepted;
   return CommandVerdict::kAccepted;
+}
+
+CommandVerdict HwBridge::OnForceCommand(int64_t utime, const Vector6d& force_n) {
+  if (bringup_.enabled) return CommandVerdict::kWrongMode;
+  const CommandVerdict verdict = AcceptCommand(utime, force_n.allFinite());
+  if (verdict == CommandVerdict::kAccepted) command_force_n_ = force_n;
+  return verdict;
+}
+
+CommandVerdict HwBridge::OnDutyCommand(int64_t utime, const Vector6d& duty) {
+  if (!bringup_.enabled) return CommandVerdict::kWrongMode;
+  const CommandVerdict verdict = AcceptCommand(utime, duty.allFinite());
+  if (verdict == CommandVerdict::kAccepted) command_duty_ = duty;
+  return verdict;
 }
 
 DriveReason HwBridge::CurrentReason() const {
@@ -117,7 +167,16 @@ std::size_t HwBridge::BuildCommandFrame(int64_t host_now_us, uint8_t* out) {
   frame.watchdog_us = static_cast<uint32_t>(std::lround(hw_.device_watchdog_s * 1e6));
   frame.flags = kCommandEnable;
   last_reason_ = CurrentReason();
-  if (last_reason_ == DriveReason::kCommand) {
+  if (last_reason_ == DriveReason::kCommand && bringup_.enabled) {
+    // The duty as commanded, after the guard on the latest readings.
+    const Vector6d duty = guard_.Apply(command_duty_);
+    if (guard_.limited_mask() != 0) ++counters_.guard_limited_frames;
+    const DriveResult drive = drive_map_.DutyToDrive(duty);
+    frame.drive = drive.drive;
+    for (int i = 0; i < kNumLegs; ++i) {
+      counters_.duty_clamped += (drive.duty_clamped_mask >> i) & 1U;
+    }
+  } else if (last_reason_ == DriveReason::kCommand) {
     const DriveResult drive = drive_map_.ForceToDrive(command_force_n_);
     frame.drive = drive.drive;
     for (int i = 0; i < kNumLegs; ++i) {
@@ -131,6 +190,7 @@ std::size_t HwBridge::BuildCommandFrame(int64_t host_now_us, uint8_t* out) {
     ++counters_.zero_drive_frames;
   }
   ++counters_.command_frames;
+  sent_watchdog_us_ = frame.watchdog_us;
   rtt_.OnSent(frame.seq, host_now_us);
   sent_since_sample_ = true;
   tick_frame_due_ = false;
@@ -153,7 +213,19 @@ LinkHealth HwBridge::Health(int64_t host_now_us, const std::string& link_descrip
   }
   if (last_reason_ != DriveReason::kCommand) {
     return {LinkState::kDegraded,
-            std::string("zero drive: ") + ToString(last_reason_) + " safe command"};
+            std::string("zero drive: ") + ToString(last_reason_) +
+                (bringup_.enabled ? " duty command (bring-up)" : " safe command")};
+  }
+  if (bringup_.enabled && guard_.tripped_mask() != 0) {
+    std::string legs;
+    for (int i = 0; i < kNumLegs; ++i) {
+      if ((guard_.tripped_mask() >> i) & 1U) {
+        legs += (legs.empty() ? "" : ", ") + std::to_string(i) + " (" + ToString(guard_.reason(i)) +
+                ")";
+      }
+    }
+    return {LinkState::kDegraded, "bring-up guard holds leg " + legs +
+                                      " at zero duty until a zero duty command re-arms it"};
   }
   if (device_faults != 0) {
     return {LinkState::kDegraded, "device status " + std::to_string(last_device_status_)};

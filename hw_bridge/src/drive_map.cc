@@ -39,6 +39,21 @@ DriveResult DriveMap::ForceToDrive(const Vector6d& force_n) const {
   return result;
 }
 
+DriveResult DriveMap::DutyToDrive(const Vector6d& duty) const {
+  DriveResult result;
+  for (int i = 0; i < kNumLegs; ++i) {
+    double d = duty(i);
+    if (!std::isfinite(d)) continue;
+    if (std::abs(d) > max_duty_) {
+      d = std::copysign(max_duty_, d);
+      result.duty_clamped_mask |= static_cast<uint8_t>(1U << i);
+    }
+    result.drive[static_cast<std::size_t>(i)] =
+        static_cast<int16_t>(std::lround(drive_sign_(i) * d * kDriveFullScale));
+  }
+  return result;
+}
+
 Vector6d DriveMap::DriveToForce(const DriveArray& drive) const {
   Vector6d force = Vector6d::Zero();
   for (int i = 0; i < kNumLegs; ++i) {

@@ -1,9 +1,13 @@
 // stewart_identify: the platform's mass properties (with its payload) from a
 // short excitation run of the stack, written as a config overlay
-// (docs/hardware.md, "Identify the platform and its payload").
+// (docs/hardware.md, "Identify the platform and its payload"), or the
+// DC-motor legs' parameters from a bring-up procedure (docs/hardware.md,
+// "Identify the actuators"; actuator_mode.h).
 //
 //   stewart_identify --mode payload --plant sim --truth payload.yaml --out identified.yaml
 //   stewart_identify --mode payload --log runs/<run>/log.lcm --out identified.yaml
+//   stewart_identify --mode actuators --plant hw --overlay config/overlays/p16p.yaml --out
+//   motors.yaml
 #include <spdlog/spdlog.h>
 #include <sys/wait.h>
 
@@ -13,6 +17,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "actuator_mode.h"
 #include "log_samples.h"
 #include "stewart/config/config_loader.h"
 #include "stewart/identify/inertial_fit.h"
@@ -150,11 +155,16 @@ int Identify(const Options& o) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"Identify the platform's mass properties (with its payload) as a config overlay"};
+  CLI::App app{
+      "Identify the platform's mass properties (with its payload) or the DC-motor legs' "
+      "parameters as a config overlay"};
   Options o;
-  app.add_option("--mode", o.mode, "what to identify: payload (the platform body with its load)")
+  stewart::identify::ActuatorModeOptions a;
+  app.add_option("--mode", o.mode,
+                 "what to identify: payload (the platform body with its load) | actuators (the "
+                 "DC-motor legs, bring-up, before the filter is armed)")
       ->required()
-      ->check(CLI::IsMember({"payload"}));
+      ->check(CLI::IsMember({"payload", "actuators"}));
   app.add_option("--out", o.out_path, "overlay file to write")->required();
   app.add_option("--plant", o.plant, "sim | hw (the excitation run's plant)")
       ->check(CLI::IsMember({"sim", "hw"}))
@@ -181,6 +191,42 @@ int main(int argc, char** argv) {
   app.add_option("--window", o.window_s, "integration window of the fit (s)")
       ->check(CLI::Range(0.01, 5.0))
       ->capture_default_str();
+  // --mode actuators only.
+  app.add_flag("--in-process", a.in_process,
+               "actuators, with --plant hw --device-emulator: the emulator behind hw_bridge's "
+               "library in this process (no LCM)");
+  app.add_flag("--bridge-running", a.bridge_running,
+               "actuators, --plant hw: use the hw_bridge --bringup already on the LCM URL");
+  app.add_option("--device-port", a.device_port,
+                 "actuators, --plant hw: the device's UDP port (default hw_bridge.device_port)")
+      ->check(CLI::Range(0, 65535));
+  app.add_option("--local-port", a.local_port,
+                 "actuators, --plant hw: the bridge's UDP port (default hw_bridge.local_port)")
+      ->check(CLI::Range(0, 65535));
+  app.add_option("--legs", a.legs, "actuators: the legs to identify (default all)")
+      ->check(CLI::Range(0, 5))
+      ->delimiter(',');
+  app.add_option("--repeats", a.repeats, "actuators: the excursions, this many times")
+      ->check(CLI::Range(1, 20))
+      ->capture_default_str();
+  app.add_option("--excursion", a.excursion_m, "actuators: each excursion's length (m, 0.008)")
+      ->check(CLI::Range(0.002, 0.05));
+  app.add_option("--max-duty", a.max_duty, "actuators: |duty| limit (default hw_bridge.max_duty)")
+      ->check(CLI::Range(0.05, 1.0));
+  app.add_option("--guard-margin", a.guard_margin_m,
+                 "actuators: the guard's end zone (m; default safety.leg_stroke.margin_m)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--speed-cap", a.speed_cap_mps,
+                 "actuators: the guard's leg speed cap (m/s; default twice the full-duty speed "
+                 "of actuators.motor)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--coulomb-sigma", a.coulomb_sigma_n,
+                 "actuators: one sigma of the assumed coulomb_friction_n (N; default its value)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--sample-timeout", a.sample_timeout_s,
+                 "actuators, --plant hw: no sample for this long ends the run (s)")
+      ->check(CLI::Range(0.1, 60.0))
+      ->capture_default_str();
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -189,6 +235,18 @@ int main(int argc, char** argv) {
     return status == 0 ? ToInt(ExitCode::kOk) : ToInt(ExitCode::kBadInput);
   }
   try {
+    if (o.mode == "actuators") {
+      a.plant = o.plant;
+      a.device_emulator = o.device_emulator;
+      a.out_path = o.out_path;
+      a.config_path = o.config_path;
+      a.overlay_paths = o.overlay_paths;
+      a.truth_path = o.truth_path;
+      a.seed = o.seed;
+      a.lcm_url = o.lcm_url;
+      a.run_dir = o.run_dir;
+      return stewart::identify::IdentifyActuators(a);
+    }
     return Identify(o);
   } catch (const stewart::InputError& e) {
     spdlog::error("{}", e.what());

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "stewart/common/enum_table.h"
+#include "stewart/hw_bridge/bringup.h"
 #include "stewart/hw_bridge/calibration.h"
 #include "stewart/hw_bridge/drive_map.h"
 #include "stewart/hw_bridge/hw_bridge_config.h"
@@ -28,9 +29,11 @@ struct SensorSample {
   int32_t status = 0;  ///< sensor_t.STATUS_* bits
 };
 
-/// Why the last command frame carried what it carried.
+/// Why the last command frame carried what it carried. In bring-up mode
+/// (bringup.h) "command" is the latest duty command, else the latest safe
+/// force command.
 enum class DriveReason {
-  kCommand,  ///< the latest safe command, mapped
+  kCommand,  ///< the latest command, mapped
   kMissing,  ///< no valid command received yet: zero drive
   kStale,    ///< the held command is older than command_timeout_s: zero drive
   kInvalid,  ///< the latest command was non-finite: zero drive
@@ -49,12 +52,14 @@ enum class CommandVerdict {
   kOutOfOrder,  ///< older than the held command: ignored
   kFuture,      ///< newer than the newest sample by more than the timeout:
                 ///< another time base (a second stack?), ignored
+  kWrongMode,   ///< a force command in bring-up mode, a duty command outside it: ignored
 };
-inline constexpr EnumTable<CommandVerdict, 4> kCommandVerdictNames{{{
+inline constexpr EnumTable<CommandVerdict, 5> kCommandVerdictNames{{{
     {CommandVerdict::kAccepted, "accepted"},
     {CommandVerdict::kNonFinite, "non_finite_command"},
     {CommandVerdict::kOutOfOrder, "out_of_order_command"},
     {CommandVerdict::kFuture, "future_command"},
+    {CommandVerdict::kWrongMode, "wrong_mode_command"},
 }}};
 inline const char* ToString(CommandVerdict verdict) {
   return kCommandVerdictNames.Name(verdict).data();
@@ -93,8 +98,10 @@ struct BridgeCounters {
   uint64_t force_clamped = 0;      ///< legs clamped to the force limit (frames x legs)
   uint64_t duty_clamped = 0;
   uint64_t force_deadzoned =
-      0;  ///< legs whose non-zero force fell in the dead zone (frames x legs)
-  uint64_t device_rx_corrupt = 0;  ///< the device's own counters (latest)
+      0;                     ///< legs whose non-zero force fell in the dead zone (frames x legs)
+  uint64_t guard_trips = 0;  ///< bring-up: legs the guard tripped (events)
+  uint64_t guard_limited_frames = 0;  ///< bring-up: frames in which the guard zeroed a leg's duty
+  uint64_t device_rx_corrupt = 0;     ///< the device's own counters (latest)
   uint64_t device_rx_lost = 0;
   WindowStats rtt_us;    ///< command round trip, per health window
   WindowStats delay_us;  ///< host arrival - sample utime, per health window
@@ -102,7 +109,9 @@ struct BridgeCounters {
 
 class HwBridge {
  public:
-  HwBridge(const HwBridgeConfig& hw, double min_length_m, double stroke_m, double force_limit_n);
+  /// `bringup`: hw_bridge --bringup (bringup.h); off by default.
+  HwBridge(const HwBridgeConfig& hw, double min_length_m, double stroke_m, double force_limit_n,
+           const BringupOptions& bringup = {});
 
   /// A decoded sensor frame that arrived at host_rx_us. Returns false (and
   /// counts) when it must not be published: duplicate or reordered.
@@ -110,8 +119,12 @@ class HwBridge {
   /// Any decoded frame from the device; *sample is set for kPublish.
   FrameOutcome OnFrame(const DecodedFrame& frame, int64_t host_rx_us, SensorSample* sample);
 
-  /// A safe command (force_command_t.utime, force_n).
+  /// A safe command (force_command_t.utime, force_n). kWrongMode in bring-up.
   CommandVerdict OnForceCommand(int64_t utime, const Vector6d& force_n);
+  /// Bring-up only (kWrongMode otherwise): a duty per leg (duty_command_t:
+  /// utime = the sample it answers, duty positive extends), with the same
+  /// checks of time and finiteness as a force command.
+  CommandVerdict OnDutyCommand(int64_t utime, const Vector6d& duty);
 
   /// True when a sensor frame arrived and no command frame went out since
   /// the previous one: the keep-alive frame of this tick is due.
@@ -128,6 +141,11 @@ class HwBridge {
   /// zero drive, device fault bits. `link_description` names the transport.
   LinkHealth Health(int64_t host_now_us, const std::string& link_description) const;
   int64_t latest_sample_utime() const { return latest_sample_utime_; }
+  bool bringup() const { return bringup_.enabled; }
+  /// Bring-up: what the device applied, as of the latest sensor frame.
+  const AppliedDuty& applied() const { return applied_; }
+  /// Bring-up: the guard on the bridge's readings.
+  const LegGuard& guard() const { return guard_; }
   uint16_t last_device_status() const { return last_device_status_; }
   const BridgeCounters& counters() const { return counters_; }
   void ResetWindows() {
@@ -137,6 +155,8 @@ class HwBridge {
 
  private:
   DriveReason CurrentReason() const;
+  CommandVerdict AcceptCommand(int64_t utime, bool finite);
+  void UpdateBringup(const SensorFrame& frame, const SensorSample& sample);
 
   HwBridgeConfig hw_;
   LegCalibration calibration_;
@@ -158,6 +178,14 @@ class HwBridge {
   bool command_invalid_ = false;
   int64_t command_utime_ = 0;
   Vector6d command_force_n_ = Vector6d::Zero();
+  Vector6d command_duty_ = Vector6d::Zero();
+
+  BringupOptions bringup_;
+  LegGuard guard_;
+  AppliedDuty applied_;
+  DriveArray applied_drive_{};  // the device's applied drive, latest frame
+  bool have_applied_ = false;
+  uint32_t sent_watchdog_us_ = 0;
   uint32_t next_command_seq_ = 1;
   DriveReason last_reason_ = DriveReason::kMissing;
 };

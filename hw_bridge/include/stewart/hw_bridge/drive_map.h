@@ -31,6 +31,10 @@ class DriveMap {
 
   /// Non-finite forces must be rejected before; they give zero drive here.
   DriveResult ForceToDrive(const Vector6d& force_n) const;
+  /// Bring-up (bringup.h): a duty per leg straight to the drive,
+  /// drive = drive_sign_i round(clamp(duty, +-max_duty) * 32767); non-finite
+  /// duty gives zero drive.
+  DriveResult DutyToDrive(const Vector6d& duty) const;
   /// The inverse outside the clamps (the emulator's actuator model): a duty
   /// within the deadband gives zero force (the leg self-locks).
   Vector6d DriveToForce(const DriveArray& drive) const;
