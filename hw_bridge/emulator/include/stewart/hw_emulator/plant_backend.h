@@ -5,7 +5,8 @@
 //
 //   drive counts --(inverse of the bridge's DriveMap)--> leg force commands
 //     --> stewart::Plant (SUNDIALS; saturation, friction, end-stops, lock)
-//     --> stewart::SensorModel (pot noise + ADC, IMU with bias and noise)
+//     --> stewart::SensorModel (pot noise, IMU with bias and noise; the pots
+//         are quantised once, by the device's ADC below)
 //     --(inverse of the bridge's LegCalibration / ImuScale)--> raw readings
 //
 // With the bridge's forward maps on the host side, bridge + emulator equal
