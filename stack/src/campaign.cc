@@ -11,11 +11,24 @@
 #include "stewart/config/config_loader.h"
 #include "stewart/config/scenario_loader.h"
 #include "stewart/config/truth_loader.h"
+#include "stewart/identify/simulated_identification.h"
 #include "stewart/stack/campaign_summary.h"
 #include "stewart/stack/random_scenario.h"
 
 namespace stewart {
 namespace {
+
+// The stack's config with the actuators identified on this run's plant.
+StackConfig IdentifiedConfig(const CampaignSpec& spec, const PlantTruth& truth,
+                             std::uint32_t seed) {
+  const std::string overlay = identify::IdentifyActuatorsInSimulation(
+      spec.config, truth, "stewart_campaign run seed " + std::to_string(seed));
+  YAML::Node merged = YAML::Clone(spec.config_root);
+  ApplyConfigOverlay(YAML::Load(overlay), "identified actuators", &merged);
+  std::stringstream text;
+  text << merged;
+  return ParseStackConfig(text.str());
+}
 
 std::uint64_t SplitMix64(std::uint64_t x) {
   x += 0x9E3779B97F4A7C15ULL;
@@ -120,7 +133,21 @@ CampaignRow RunCampaignRow(const CampaignSpec& spec, long index, std::ostream* t
   row.index = index;
   row.seed = run.seed;
   row.sampled = run.sampled;
-  row.summary = RunClosedLoop(spec.config, run.scenario, options, trajectory);
+  if (spec.identify_actuators) {
+    StackConfig identified;
+    try {
+      identified = IdentifiedConfig(spec, run.truth, run.seed);
+    } catch (const std::exception& e) {
+      row.summary.failure = std::string("actuator identification: ") + e.what();
+      for (std::string& name : LimitNames(spec.config.safety)) {
+        row.summary.limit_margins.push_back({name, std::numeric_limits<double>::quiet_NaN()});
+      }
+      return row;
+    }
+    row.summary = RunClosedLoop(identified, run.scenario, options, trajectory);
+  } else {
+    row.summary = RunClosedLoop(spec.config, run.scenario, options, trajectory);
+  }
   row.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   return row;
 }

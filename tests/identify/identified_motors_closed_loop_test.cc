@@ -15,11 +15,7 @@
 #include "stewart/config/config_loader.h"
 #include "stewart/config/default_config.h"
 #include "stewart/config/scenario_loader.h"
-#include "stewart/hw_bridge/bringup.h"
-#include "stewart/identify/actuator_fit.h"
-#include "stewart/identify/actuator_overlay.h"
-#include "stewart/identify/actuator_procedure.h"
-#include "stewart/identify/plant_device.h"
+#include "stewart/identify/simulated_identification.h"
 #include "stewart/stack/closed_loop.h"
 
 namespace stewart::identify {
@@ -77,20 +73,10 @@ TEST_P(IdentifiedMotors, PaperScenarioHoldsTheLimitsAfterTheIdentification) {
   const PlantTruth truth = TruthOf(config, GetParam());
 
   // Identify, as stewart_identify --mode actuators --plant sim does.
-  PlantDevice device(config, truth);
-  ActuatorProcedureOptions procedure;
-  procedure.guard =
-      hw::DefaultBringupGuard(config.platform.leg_min_length_m, config.platform.leg_max_length_m,
-                              config.safety.leg_stroke.margin_m, config.actuators.motor);
-  ActuatorFitOptions fit_options;
-  fit_options.coulomb_friction_n = config.actuators.motor.coulomb_friction_n;
-  fit_options.coulomb_friction_sigma_n = fit_options.coulomb_friction_n;
-  const ActuatorFit fit = FitActuators(config.platform, config.actuators,
-                                       RunActuatorProcedure(&device, procedure), fit_options);
   const std::string overlay_path = ::testing::TempDir() + "identified_motors_" +
                                    std::to_string(::getpid()) + "_" + GetParam().name + ".yaml";
-  std::ofstream(overlay_path) << FormatActuatorOverlay(fit, config.actuators, fit_options,
-                                                       "identified_motors_closed_loop_test");
+  std::ofstream(overlay_path) << IdentifyActuatorsInSimulation(
+      config, truth, "identified_motors_closed_loop_test");
   const StackConfig identified =
       LoadStackConfig(DefaultConfigPath(), {DcMotorOverlayPath(), overlay_path});
   std::remove(overlay_path.c_str());

@@ -84,7 +84,9 @@ json Meta(const CampaignSpec& spec, long runs, const std::string& shard, int job
       {"runs", runs},
       {"shard", shard},
       {"jobs", jobs},
-      {"duration_s", spec.duration_s}};
+      {"duration_s", spec.duration_s},
+      {"perfect_state", spec.perfect_state},
+      {"identify_actuators", spec.identify_actuators}};
 }
 
 // Summary files and plots of a folder holding runs.csv and campaign.json.
@@ -125,6 +127,7 @@ CampaignSpec LoadSavedSpec(const std::string& dir) {
       MakeCampaignSpec(dir + "/config.yaml", meta["scenario"].get<std::string>(), mismatch,
                        meta["seed"].get<std::uint64_t>(), meta["duration_s"].get<double>());
   spec.perfect_state = meta.value("perfect_state", false);
+  spec.identify_actuators = meta.value("identify_actuators", false);
   return spec;
 }
 
@@ -261,7 +264,7 @@ int main(int argc, char** argv) {
   std::uint64_t seed = 1;
   int jobs = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   double duration_s = 0.0;
-  bool no_plots = false, emit_truth = false, perfect_state = false;
+  bool no_plots = false, emit_truth = false, perfect_state = false, identify_actuators = false;
   std::string log_level = "error";
   std::vector<std::string> merge_dirs;
   app.add_option("--config", config_path, "stack YAML config (the model every run's stack uses)")
@@ -286,6 +289,9 @@ int main(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   app.add_option("--out", out, "output folder")->capture_default_str();
   app.add_flag("--no-plots", no_plots, "skip the matplotlib plots");
+  app.add_flag("--identify-actuators", identify_actuators,
+               "identify each run's DC-motor legs in simulation first (stewart_identify --mode "
+               "actuators --plant sim) and run the stack with the identified motors");
   app.add_flag("--perfect-state", perfect_state,
                "ground truth to the controller and filter instead of the EKF");
   app.add_option("--log-level", log_level,
@@ -314,6 +320,11 @@ int main(int argc, char** argv) {
     }
     CampaignSpec spec = MakeCampaignSpec(config_path, scenario, mismatch, seed, duration_s);
     spec.perfect_state = perfect_state;
+    spec.identify_actuators = identify_actuators;
+    if (identify_actuators && spec.config.actuators.kind != ActuatorKind::kDcMotor) {
+      throw InputError("--identify-actuators",
+                       "needs a config with actuators.model dc_motor (config/overlays/p16p.yaml)");
+    }
     return Run(spec, runs, shard, shards, jobs, out, !no_plots);
   } catch (const InputError& e) {
     spdlog::error("stewart_campaign: {}", e.what());

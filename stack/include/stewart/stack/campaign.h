@@ -37,6 +37,10 @@ struct CampaignSpec {
   /// Ground truth to the controller and filter instead of the EKF (to tell
   /// the estimator's share of a failure from the rest's).
   bool perfect_state = false;
+  /// Before each run, identify the truth's DC-motor legs in simulation
+  /// (stewart_identify --mode actuators --plant sim) and run the stack with
+  /// the identified actuators.motor overlay on `config`.
+  bool identify_actuators = false;
 };
 
 /// Loads the config, the distribution (if any) and checks the scenario.
