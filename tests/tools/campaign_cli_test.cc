@@ -11,6 +11,8 @@
 #include <sstream>
 #include <string>
 
+#include "stewart/config/config_loader.h"
+#include "stewart/config/default_config.h"
 #include "stewart/stack/campaign_summary.h"
 
 namespace stewart {
@@ -123,6 +125,36 @@ TEST_F(CampaignCli, BadDistributionExitsTwoNamingTheKey) {
       << ReadText(out);
   EXPECT_EQ(Shell(bin_ + " --runs 2 --shard 3/2 --out " + dir_ + "/d > " + out + " 2>&1"), 2);
   EXPECT_NE(ReadText(out).find("--shard"), std::string::npos) << ReadText(out);
+}
+
+// --identify-actuators: each run identifies its plant's P-16P motors first;
+// the runs complete on the identified motors, the folder records the flag,
+// and a config without DC-motor legs is refused naming the flag.
+TEST_F(CampaignCli, IdentifyActuatorsRunsOnTheIdentifiedMotors) {
+  const std::string p16p = dir_ + "/p16p.yaml";
+  std::ofstream(p16p) << LoadMergedConfigYaml(DefaultConfigPath(), {DcMotorOverlayPath()});
+  const std::string out = dir_ + "/ident.out";
+  const std::string folder = dir_ + "/ident";
+  ASSERT_EQ(Shell(bin_ + " --config " + p16p +
+                  " --runs 2 --jobs 2 --duration 5 --scenario paper --no-plots --mismatch " +
+                  std::string(STEWART_SOURCE_DIR) +
+                  "/config/campaigns/p16p-actuators.yaml --identify-actuators --out " + folder +
+                  " > " + out + " 2>&1"),
+            0)
+      << ReadText(out);
+  EXPECT_NE(ReadText(folder + "/campaign.json").find("\"identify_actuators\": true"),
+            std::string::npos);
+  const CsvTable runs = ReadCsv(folder + "/runs.csv");
+  ASSERT_EQ(runs.rows.size(), 2u);
+  const auto completed = static_cast<std::size_t>(runs.Column("completed"));
+  const auto failure = static_cast<std::size_t>(runs.Column("failure"));
+  for (const auto& row : runs.rows) {
+    EXPECT_EQ(row[completed], "1");
+    EXPECT_EQ(row[failure], "");
+  }
+  EXPECT_EQ(Shell(bin_ + " --runs 2 --identify-actuators --out " + dir_ + "/e > " + out + " 2>&1"),
+            2);
+  EXPECT_NE(ReadText(out).find("--identify-actuators"), std::string::npos) << ReadText(out);
 }
 
 }  // namespace
