@@ -75,17 +75,21 @@ ProjectionResultN<MaxRows> SolveProjectionQp(const ProjectionQpN<MaxRows>& qp) {
   std::array<int, 6> active{};
   int num_active = 0;
   std::array<bool, MaxRows> is_active{};
+  // The rows' lengths, once (every iteration scans every inactive row).
+  std::array<double, MaxRows> row_norm{};
+  for (int i = 0; i < qp.m; ++i) row_norm[static_cast<size_t>(i)] = qp.a.row(i).norm();
 
   for (int iter = 0; iter < kMaxIterations<MaxRows>; ++iter) {
     res.iterations = iter + 1;
     // Most violated inactive constraint, scaled by its normal's length.
     int p = -1;
     double worst = 0.0;
+    const double x_norm = res.x.norm();
     for (int i = 0; i < qp.m; ++i) {
       if (is_active[static_cast<size_t>(i)]) continue;
-      const double norm = qp.a.row(i).norm();
+      const double norm = row_norm[static_cast<size_t>(i)];
       const double slack = qp.a.row(i).dot(res.x) - qp.b(i);
-      const double tol = kFeasTol * (std::fabs(qp.b(i)) + norm * res.x.norm());
+      const double tol = kFeasTol * (std::fabs(qp.b(i)) + norm * x_norm);
       if (slack < -tol && slack / norm < worst) {
         worst = slack / norm;
         p = i;
