@@ -125,6 +125,7 @@ void PlantSimNode::AdvanceTick() {
   const PlantCounters c = plant_.counters();
   health_.SetCounter("endstop_hits", c.endstop_hits);
   health_.SetCounter("stiff_fallbacks", c.stiff_fallbacks);
+  health_.SetCounter("self_lock_engagements", c.self_lock_engagements);
   health_.SetCounter("ticks", tick_ + 1);
   if (tick_ % 100 == 0) {
     UpdateLatencyCounters();
