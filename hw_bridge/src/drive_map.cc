@@ -2,15 +2,28 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "stewart/hw_bridge/wire_format.h"
 
 namespace stewart::hw {
 
+namespace {
+
+ForceToDutyMap UnclampedMap(const HwBridgeConfig& hw) {
+  ForceToDutyMap map;
+  map.force_limit_n = std::numeric_limits<double>::infinity();
+  map.force_at_full_duty_n = hw.force_at_full_duty_n;
+  map.dead_band_duty = hw.duty_deadband;
+  map.max_duty = std::numeric_limits<double>::infinity();
+  return map;
+}
+
+}  // namespace
+
 DriveMap::DriveMap(const HwBridgeConfig& hw, double force_limit_n)
     : force_limit_n_(force_limit_n),
-      force_at_full_duty_n_(hw.force_at_full_duty_n),
-      duty_deadband_(hw.duty_deadband),
+      map_(UnclampedMap(hw)),
       force_deadzone_n_(hw.force_deadzone_n),
       max_duty_(hw.max_duty),
       drive_sign_(hw.drive_sign) {}
@@ -24,8 +37,7 @@ DriveResult DriveMap::ForceToDrive(const Vector6d& force_n) const {
     if (f_c != f) result.force_clamped_mask |= static_cast<uint8_t>(1U << i);
     double duty = 0.0;
     if (std::abs(f_c) >= force_deadzone_n_ && f_c != 0.0) {
-      duty = std::copysign(
-          duty_deadband_ + (1.0 - duty_deadband_) * std::abs(f_c) / force_at_full_duty_n_, f_c);
+      duty = DutyForForce(map_, f_c);
     } else if (f_c != 0.0) {
       result.deadzone_mask |= static_cast<uint8_t>(1U << i);
     }
@@ -55,13 +67,9 @@ DriveResult DriveMap::DutyToDrive(const Vector6d& duty) const {
 }
 
 Vector6d DriveMap::DriveToForce(const DriveArray& drive) const {
-  Vector6d force = Vector6d::Zero();
-  for (int i = 0; i < kNumLegs; ++i) {
-    const double duty = drive_sign_(i) * drive[static_cast<std::size_t>(i)] / kDriveFullScale;
-    const double excess = std::abs(duty) - duty_deadband_;
-    if (excess <= 0.0) continue;
-    force(i) = std::copysign(excess / (1.0 - duty_deadband_) * force_at_full_duty_n_, duty);
-  }
+  const Vector6d duty = Duty(drive);
+  Vector6d force;
+  for (int i = 0; i < kNumLegs; ++i) force(i) = ForceForDuty(map_, duty(i));
   return force;
 }
 
@@ -76,7 +84,7 @@ Vector6d DriveMap::Duty(const DriveArray& drive) const {
 std::array<bool, 6> DriveMap::Locked(const DriveArray& drive) const {
   std::array<bool, 6> locked{};
   for (std::size_t i = 0; i < 6; ++i) {
-    locked[i] = std::abs(drive[i] / static_cast<double>(kDriveFullScale)) <= duty_deadband_;
+    locked[i] = EffectiveDuty(map_, drive[i] / static_cast<double>(kDriveFullScale)) == 0.0;
   }
   return locked;
 }

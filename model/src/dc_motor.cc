@@ -14,28 +14,24 @@ double DcMotorForceAtFullDuty(const DcMotorParams& motor) {
          motor.rated_voltage_v;
 }
 
-double DcMotorEffectiveDuty(const DcMotorParams& motor, double duty) {
+ForceToDutyMap DcMotorDutyMap(const DcMotorParams& motor) {
+  ForceToDutyMap map;
+  map.force_at_full_duty_n = DcMotorForceAtFullDuty(motor);
+  map.force_limit_n = map.force_at_full_duty_n;
+  map.dead_band_duty = motor.dead_band_duty;
+  map.max_duty = 1.0;
+  return map;
+}
+
+double EffectiveDuty(const ForceToDutyMap& map, double duty) {
   if (!std::isfinite(duty)) return 0.0;
-  const double magnitude = std::min(std::abs(duty), 1.0);
-  const double excess = magnitude - motor.dead_band_duty;
+  const double excess = std::min(std::abs(duty), 1.0) - map.dead_band_duty;
   if (excess <= 0.0) return 0.0;
-  return std::copysign(excess / (1.0 - motor.dead_band_duty), duty);
+  return std::copysign(excess / (1.0 - map.dead_band_duty), duty);
 }
 
-double DcMotorDriveForce(const DcMotorParams& motor, double duty) {
-  return DcMotorEffectiveDuty(motor, duty) * DcMotorForceAtFullDuty(motor);
-}
-
-double DcMotorDutyForDriveForce(const DcMotorParams& motor, double drive_force_n) {
-  if (!std::isfinite(drive_force_n) || drive_force_n == 0.0) return 0.0;
-  const double u = std::min(std::abs(drive_force_n) / DcMotorForceAtFullDuty(motor), 1.0);
-  return std::copysign(motor.dead_band_duty + (1.0 - motor.dead_band_duty) * u, drive_force_n);
-}
-
-Vector6d DcMotorDutyForDriveForce(const DcMotorParams& motor, const Vector6d& drive_force_n) {
-  Vector6d duty;
-  for (int i = 0; i < kNumLegs; ++i) duty(i) = DcMotorDutyForDriveForce(motor, drive_force_n(i));
-  return duty;
+double ForceForDuty(const ForceToDutyMap& map, double duty) {
+  return EffectiveDuty(map, duty) * map.force_at_full_duty_n;
 }
 
 double DutyForForce(const ForceToDutyMap& map, double force_n) {
@@ -50,6 +46,22 @@ Vector6d DutyForForce(const ForceToDutyMap& map, const Vector6d& force_n) {
   Vector6d duty;
   for (int i = 0; i < kNumLegs; ++i) duty(i) = DutyForForce(map, force_n(i));
   return duty;
+}
+
+double DcMotorEffectiveDuty(const DcMotorParams& motor, double duty) {
+  return EffectiveDuty(DcMotorDutyMap(motor), duty);
+}
+
+double DcMotorDriveForce(const DcMotorParams& motor, double duty) {
+  return ForceForDuty(DcMotorDutyMap(motor), duty);
+}
+
+double DcMotorDutyForDriveForce(const DcMotorParams& motor, double drive_force_n) {
+  return DutyForForce(DcMotorDutyMap(motor), drive_force_n);
+}
+
+Vector6d DcMotorDutyForDriveForce(const DcMotorParams& motor, const Vector6d& drive_force_n) {
+  return DutyForForce(DcMotorDutyMap(motor), drive_force_n);
 }
 
 double ModelLegDampingNspm(const ActuatorConfig& actuators) {

@@ -54,11 +54,8 @@ void PlantDerivativeGivenTerms(const PlantModel& model, const PlantInputs& input
 
 ForceToDutyMap PlantModel::DriverOf(const ActuatorConfig& actuators) {
   ForceToDutyMap map;
+  if (actuators.kind == ActuatorKind::kDcMotor) map = DcMotorDutyMap(actuators.motor);
   map.force_limit_n = actuators.force_limit_n;
-  if (actuators.kind == ActuatorKind::kDcMotor) {
-    map.force_at_full_duty_n = DcMotorForceAtFullDuty(actuators.motor);
-    map.dead_band_duty = actuators.motor.dead_band_duty;
-  }
   return map;
 }
 

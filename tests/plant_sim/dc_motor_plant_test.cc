@@ -206,18 +206,7 @@ TEST(DcMotorAccuracy, MatchesFineRk4WithZeroOrderHold) {
     plant.SetDutyCommand(duty);
     u_ref.duty = duty;
     plant.Advance(dt);
-    for (int s = 0; s < substeps; ++s) {
-      const double h = dt / substeps;
-      PlantRates r;
-      PlantDerivative(model, u_ref, x_ref, &r);
-      const PlantStateVector k1 = r.x_dot;
-      PlantDerivative(model, u_ref, x_ref + h / 2 * k1, &r);
-      const PlantStateVector k2 = r.x_dot;
-      PlantDerivative(model, u_ref, x_ref + h / 2 * k2, &r);
-      const PlantStateVector k3 = r.x_dot;
-      PlantDerivative(model, u_ref, x_ref + h * k3, &r);
-      x_ref += h / 6 * (k1 + 2 * k2 + 2 * k3 + r.x_dot);
-    }
+    for (int s = 0; s < substeps; ++s) x_ref = test::Rk4Step(model, u_ref, x_ref, dt / substeps);
     max_err_q = std::max(max_err_q, (plant.q() - x_ref.segment<6>(0)).cwiseAbs().maxCoeff());
     max_err_qd = std::max(max_err_qd, (plant.qd() - x_ref.segment<6>(6)).cwiseAbs().maxCoeff());
     max_excursion = std::max(max_excursion, (plant.q() - q0).cwiseAbs().maxCoeff());

@@ -13,20 +13,6 @@ namespace {
 
 using test::Config;
 
-PlantStateVector Rk4Step(const PlantModel& model, const PlantInputs& u, const PlantStateVector& x,
-                         double h) {
-  PlantRates r;
-  PlantDerivative(model, u, x, &r);
-  const PlantStateVector k1 = r.x_dot;
-  PlantDerivative(model, u, x + h / 2 * k1, &r);
-  const PlantStateVector k2 = r.x_dot;
-  PlantDerivative(model, u, x + h / 2 * k2, &r);
-  const PlantStateVector k3 = r.x_dot;
-  PlantDerivative(model, u, x + h * k3, &r);
-  const PlantStateVector k4 = r.x_dot;
-  return x + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4);
-}
-
 // Holding force, leg-space PD about the home leg lengths (constant holding
 // forces alone leave the platform unstable) and a smooth excitation of
 // every leg. Computed from the reference trajectory at each control tick and
@@ -72,7 +58,7 @@ TEST_P(PlantAccuracy, MatchesFineRk4WithZeroOrderHold) {
     u_ref.force_cmd_n = f;
     if (!(model.actuators.force_lag_s > 0.0)) x_ref.segment<6>(12) = f;
     plant.Advance(dt);
-    for (int s = 0; s < substeps; ++s) x_ref = Rk4Step(model, u_ref, x_ref, dt / substeps);
+    for (int s = 0; s < substeps; ++s) x_ref = test::Rk4Step(model, u_ref, x_ref, dt / substeps);
     max_err_q = std::max(max_err_q, (plant.q() - x_ref.segment<6>(0)).cwiseAbs().maxCoeff());
     max_err_qd = std::max(max_err_qd, (plant.qd() - x_ref.segment<6>(6)).cwiseAbs().maxCoeff());
     max_excursion = std::max(max_excursion, (plant.q() - q0).cwiseAbs().maxCoeff());

@@ -162,9 +162,15 @@ TEST(PlantSimProcess, LockstepGivesByteIdenticalGroundTruth) {
 double SinkAfter(int port, const std::string& truth_path, double duration_s) {
   const std::string url = PrivateLcmUrl(port);
   Stack stack(url, true, /*hold_only=*/true);
-  std::vector<std::string> args = {PLANT_SIM_BIN, "--lcm-url",  url,
-                                   "--mode",      "lockstep",   "--duration",
-                                   std::to_string(duration_s), "--log-level", "warn"};
+  std::vector<std::string> args = {PLANT_SIM_BIN,
+                                   "--lcm-url",
+                                   url,
+                                   "--mode",
+                                   "lockstep",
+                                   "--duration",
+                                   std::to_string(duration_s),
+                                   "--log-level",
+                                   "warn"};
   if (!truth_path.empty()) {
     args.push_back("--truth");
     args.push_back(truth_path);

@@ -4,6 +4,7 @@
 #include <cstdint>
 
 #include "stewart/hw_bridge/hw_bridge_config.h"
+#include "stewart/model/dc_motor.h"
 #include "stewart/model/types.h"
 
 namespace stewart::hw {
@@ -22,6 +23,7 @@ struct DriveResult {
 /// For each leg, with F_c = clamp(F, +-force_limit_n):
 ///   duty = 0                                                        if |F_c| < force_deadzone_n
 ///   duty = sign(F_c) (duty_deadband + (1 - duty_deadband) |F_c| / force_at_full_duty_n)  else
+///          (DutyForForce, model/dc_motor.h)
 ///   duty = clamp(duty, +-max_duty);  drive = drive_sign_i round(duty * 32767)
 /// The deadband term overcomes the lead screw's static friction: below it the
 /// P-16P does not move. Positive force extends the leg.
@@ -45,8 +47,9 @@ class DriveMap {
 
  private:
   double force_limit_n_;
-  double force_at_full_duty_n_;
-  double duty_deadband_;
+  // The duty equation (model/dc_motor.h), unclamped: ForceToDrive clamps and
+  // reports the clamps itself.
+  ForceToDutyMap map_;
   double force_deadzone_n_;
   double max_duty_;
   Vector6d drive_sign_;
