@@ -7,6 +7,8 @@ find_package(nlohmann_json 3 REQUIRED)
 find_package(GTest REQUIRED)
 find_package(benchmark REQUIRED)
 find_package(Threads REQUIRED)
+# HMAC-SHA256 of the authenticated channels (node/message_auth.h).
+find_package(OpenSSL 3 REQUIRED COMPONENTS Crypto)
 
 # LCM 1.3.1 ships no CMake package and its lcm.pc drags in glib headers:
 # link the library directly and run lcm-gen ourselves (see lcmtypes/).

@@ -15,6 +15,7 @@ PACKAGES=(
   coinor-libclp-dev libalglib-dev
   python3-matplotlib python3-numpy python3-pil python3-yaml
   xvfb xauth x11-utils imagemagick
+  libssl-dev
   iproute2 procps
   parallel
 )

@@ -20,6 +20,7 @@ LcmConfig ParseLcmConfig(const ConfigNode& lcm, const ConfigNode& rates) {
   }
   SetChannelSuffix(&c, suffix);
   c.health_rate_hz = rates.PositiveDouble("health_hz");
+  c.auth_key_file = lcm.Has("auth_key_file") ? lcm.String("auth_key_file") : "";
   return c;
 }
 

@@ -48,6 +48,8 @@ struct ForceCommand {
   int64_t sample_utime = 0;  ///< the sensor sample it derives from
   Eigen::Matrix<double, 6, 1> force_n = Eigen::Matrix<double, 6, 1>::Zero();
   int32_t flags = 0;  ///< kCommand* bits
+  /// Safe commands: the safety session that issued them (0 on nominal ones).
+  int64_t session_id = 0;
 };
 
 constexpr int32_t kCommandFilterActive = 1;
@@ -59,5 +61,8 @@ constexpr int32_t kCommandSetpointRejected = 32;
 constexpr int32_t kCommandForceLimited = 64;
 /// A limit is exceeded on the state the command was filtered at.
 constexpr int32_t kCommandOutsideSafeSet = 128;
+/// Actuators off, the lead screws hold the legs (supervisor DISARMED or
+/// ESTOP); force_n is zero.
+constexpr int32_t kCommandDriveOff = 256;
 
 }  // namespace stewart

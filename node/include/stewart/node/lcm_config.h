@@ -15,6 +15,8 @@ struct ChannelNames {
   std::string command_safe;
   std::string safety_diagnostics;
   std::string health;
+  std::string supervisor;        ///< supervisor_state_t: the state and the safety session
+  std::string operator_command;  ///< operator_command_t: arm, hold, resume, estop, reset
 };
 
 /// `lcm` and `rates`.
@@ -24,6 +26,8 @@ struct LcmConfig {
   std::string channel_suffix;
   ChannelNames channels;
   double health_rate_hz = 2.0;
+  /// Key of the authenticated channels (node/message_auth.h); "" = off.
+  std::string auth_key_file;
 };
 
 /// Every channel: its config key under lcm.channels and its field.
@@ -40,6 +44,8 @@ inline constexpr ChannelField kChannelFields[] = {
     {"command_safe", &ChannelNames::command_safe},
     {"safety_diagnostics", &ChannelNames::safety_diagnostics},
     {"health", &ChannelNames::health},
+    {"supervisor", &ChannelNames::supervisor},
+    {"operator", &ChannelNames::operator_command},
 };
 
 /// Applies a new suffix to every channel (two stacks on one network).

@@ -23,7 +23,8 @@ static_assert(kCommandFilterActive == force_command_t::FLAG_FILTER_ACTIVE &&
                   kCommandInvalidInput == force_command_t::FLAG_INVALID_INPUT &&
                   kCommandSetpointRejected == force_command_t::FLAG_SETPOINT_REJECTED &&
                   kCommandForceLimited == force_command_t::FLAG_FORCE_LIMITED &&
-                  kCommandOutsideSafeSet == force_command_t::FLAG_OUTSIDE_SAFE_SET,
+                  kCommandOutsideSafeSet == force_command_t::FLAG_OUTSIDE_SAFE_SET &&
+                  kCommandDriveOff == force_command_t::FLAG_DRIVE_OFF,
               "signals.h and force_command_t.FLAG_* must agree");
 
 /// For each message, the library signal it carries and the fields both share
@@ -46,7 +47,7 @@ struct SignalOf<force_command_t> {
   using Type = ForceCommand;
   template <typename Command>
   static auto Fields(Command& c) {
-    return std::tie(c.utime, c.seq, c.sample_utime, c.force_n, c.flags);
+    return std::tie(c.utime, c.seq, c.sample_utime, c.force_n, c.flags, c.session_id);
   }
 };
 
