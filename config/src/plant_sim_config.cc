@@ -13,7 +13,12 @@ PlantSimConfig ParsePlantSimConfig(const ConfigNode& plant_sim) {
   p.rel_tol = plant_sim.PositiveDouble("rel_tol");
   p.abs_tol = plant_sim.PositiveDouble("abs_tol");
   p.command_timeout_s = plant_sim.PositiveDouble("command_timeout_s");
-  p.timeout_fallback = plant_sim.Choice("timeout_fallback", {"off", "hold_last"});
+  // The fallback without a command is always actuators off. The key is
+  // optional for older configs; `hold_last` applied commands far older than
+  // command_timeout_s and is refused.
+  if (plant_sim.Has("timeout_fallback")) {
+    plant_sim.Choice("timeout_fallback", {"off"});
+  }
   p.lockstep_timeout_s = plant_sim.PositiveDouble("lockstep_timeout_s");
   p.initial_pose = plant_sim.Vec6("initial_pose");
   p.initial_velocity = plant_sim.Vec6("initial_velocity");

@@ -53,6 +53,9 @@ StackConfig ParseRoot(const YAML::Node& yaml, const std::string& source) {
   c.plant_sim = ParsePlantSimConfig(root.Child("plant_sim"));
   c.hw_bridge = ParseHwBridgeConfig(root.Child("hw_bridge"), c.actuators);
   c.lcm = ParseLcmConfig(root.Child("lcm"), root.Child("rates"));
+  // Optional: a run's config.yaml from before the section (which the replay
+  // loads) keeps loading, with the defaults.
+  if (root.Has("guard")) c.guard = ParseGuardConfig(root.Child("guard"));
   // One leg damping, the actuators' (screw friction and, for a DC motor, its
   // back-EMF): the controller and the filter model what the plant has (or
   // nothing, when told not to).

@@ -1,14 +1,26 @@
 #include "bridge_node.h"
 
 #include <poll.h>
+#include <spdlog/spdlog.h>
 
+#include <chrono>
+#include <cmath>
+
+#include "stewart/guard/guard_limits.h"
 #include "stewart/node/eigen_msg.h"
 #include "stewart/node/node_loop.h"
+#include "stewart/node/signal_messages.h"
 #include "stewart/node/stop_signal.h"
 #include "stewart/sensor_t.hpp"
 
 namespace stewart {
 namespace {
+
+int64_t WallMicros() {
+  return std::chrono::duration_cast<std::chrono::microseconds>(
+             std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
 
 int8_t HealthState(hw::LinkState state) {
   switch (state) {
@@ -34,9 +46,17 @@ BridgeNode::BridgeNode(const StackConfig& config, lcm::LCM* lcm, hw::Transport* 
       transport_(transport),
       bridge_(config.hw_bridge, config.platform.leg_min_length_m,
               config.platform.leg_max_length_m - config.platform.leg_min_length_m,
-              config.actuators.force_limit_n, bringup),
+              config.actuators.force_limit_n, bringup, config.guard),
+      auth_(MessageAuthenticator::FromKeyFile(config.lcm.auth_key_file)),
+      operator_check_(SecondsToMicros(config.guard.operator_max_age_s)),
       health_("hw_bridge", config.lcm.channels.health, config.lcm.health_rate_hz),
       reader_(transport->datagram()) {
+  receiver_.Subscribe(config.lcm.channels.supervisor, &BridgeNode::OnSupervisor, this);
+  receiver_.Subscribe(config.lcm.channels.operator_command, &BridgeNode::OnOperator, this);
+  spdlog::info(
+      "hw_bridge: commands accepted from the safety session announced on {}{}",
+      config.lcm.channels.supervisor,
+      auth_.enabled() ? ", authenticated (lcm.auth_key_file)" : ", no key: not authenticated");
   // In bring-up the safe commands are still heard, to be rejected and
   // counted (wrong_mode_command): a filter running then is a mistake to see.
   receiver_.Subscribe(config.lcm.channels.command_safe, &BridgeNode::OnCommand, this);
@@ -127,9 +147,56 @@ void BridgeNode::OnDutyCommand(const lcm::ReceiveBuffer*, const std::string&,
 void BridgeNode::OnCommand(const lcm::ReceiveBuffer*, const std::string&,
                            const force_command_t* msg) {
   health_.CountIn();
-  const hw::CommandVerdict verdict = bridge_.OnForceCommand(msg->utime, FromArray(msg->force_n));
-  if (verdict != hw::CommandVerdict::kAccepted) health_.Reject(ToString(verdict));
+  const hw::CommandVerdict verdict = bridge_.OnSafeCommand(FromMessage(*msg), auth_.Verify(*msg));
+  if (verdict == hw::CommandVerdict::kUntrusted) {
+    health_.Reject(ToString(bridge_.last_rejection()),
+                   "force_command_t seq " + std::to_string(msg->seq) + ", session " +
+                       std::to_string(msg->session_id) + ", sample_utime " +
+                       std::to_string(msg->sample_utime) + " (following session " +
+                       std::to_string(bridge_.acceptor().session_id()) + ")");
+  } else if (verdict != hw::CommandVerdict::kAccepted) {
+    health_.Reject(ToString(verdict));
+  }
   if (hw::SendsAtOnce(verdict)) SendCommand();
+}
+
+void BridgeNode::OnSupervisor(const lcm::ReceiveBuffer*, const std::string&,
+                              const supervisor_state_t* msg) {
+  health_.CountIn();
+  const AnnouncementVerdict v = bridge_.OnAnnouncement({msg->utime, msg->seq, msg->session_id},
+                                                       auth_.Verify(*msg), clock_.NowMicros());
+  if (IsRejection(v)) {
+    health_.Reject(ToString(v), "supervisor_state_t session " + std::to_string(msg->session_id) +
+                                    ", seq " + std::to_string(msg->seq) + ", utime " +
+                                    std::to_string(msg->utime) + " (newest sample " +
+                                    std::to_string(bridge_.latest_sample_utime()) + ")");
+  } else if (v == AnnouncementVerdict::kAdopted) {
+    spdlog::info("hw_bridge: following safety session {} (announced at utime {})", msg->session_id,
+                 msg->utime);
+  }
+}
+
+void BridgeNode::OnOperator(const lcm::ReceiveBuffer*, const std::string&,
+                            const operator_command_t* msg) {
+  // Only RESET concerns the bridge; the supervisor judges the rest.
+  if (msg->command != operator_command_t::COMMAND_RESET) return;
+  health_.CountIn();
+  const OperatorVerdict v = operator_check_.Check(msg->operator_id, msg->seq, msg->utime,
+                                                  auth_.Verify(*msg), WallMicros());
+  if (v != OperatorVerdict::kAccepted) {
+    health_.Reject(ToString(v), "operator_command_t RESET from " +
+                                    std::to_string(msg->operator_id) + ", seq " +
+                                    std::to_string(msg->seq));
+    return;
+  }
+  const bool was_tripped = bridge_.actuator_guard().tripped();
+  const std::string what = bridge_.actuator_guard().Describe();
+  const GuardResetResult r = bridge_.OnOperatorReset();
+  if (r == GuardResetResult::kCleared) {
+    spdlog::warn("hw_bridge: guard cleared by operator {} (was: {})", msg->operator_id, what);
+  } else if (was_tripped) {
+    spdlog::warn("hw_bridge: operator RESET refused: readings not back inside ({})", what);
+  }
 }
 
 void BridgeNode::SendCommand() {
@@ -165,6 +232,26 @@ void BridgeNode::UpdateHealth() {
   health_.SetCounter("device_watchdog_samples", static_cast<int64_t>(c.device_watchdog_samples));
   health_.SetCounter("device_rx_corrupt", static_cast<int64_t>(c.device_rx_corrupt));
   health_.SetCounter("device_rx_lost", static_cast<int64_t>(c.device_rx_lost));
+  const SafeCommandAcceptor& acceptor = bridge_.acceptor();
+  const ActuatorGuard& guard = bridge_.actuator_guard();
+  health_.SetCounter("safety_session", acceptor.session_id());
+  health_.SetCounter("sessions_adopted", acceptor.sessions_adopted());
+  health_.SetCounter("commands_trusted", acceptor.accepted());
+  health_.SetCounter("applied_age_max_us", c.applied_age_max_us);
+  health_.SetCounter("drive_off_frames", static_cast<int64_t>(c.drive_off_frames));
+  health_.SetCounter("guard_frames", static_cast<int64_t>(c.guard_frames));
+  health_.SetCounter("guard_tripped", guard.tripped() ? 1 : 0);
+  health_.SetCounter("guard_resets", guard.resets_cleared());
+  health_.SetCounter("guard_resets_refused", guard.resets_refused());
+  // How close the run came to the guard's limits, to size them: um, um/s, mN.
+  health_.SetCounter("guard_min_end_distance_um", std::llround(guard.min_end_distance_m() * 1e6));
+  health_.SetCounter("guard_max_speed_umps", std::llround(guard.max_speed_mps() * 1e6));
+  health_.SetCounter("guard_max_force_mn", std::llround(guard.max_force_n() * 1e3));
+  if (guard.trips() != guard_trips_logged_) {
+    guard_trips_logged_ = guard.trips();
+    if (guard.tripped()) spdlog::error("hw_bridge: guard tripped: {}", guard.Describe());
+  }
+  if (!bridge_.bringup()) health_.SetCounter("guard_trips", guard.trips());
   if (bridge_.bringup()) {
     health_.SetCounter("bringup", 1);
     health_.SetCounter("guard_trips", static_cast<int64_t>(c.guard_trips));

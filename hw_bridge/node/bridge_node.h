@@ -6,7 +6,10 @@
 // from <prefix>BRINGUP_DUTY instead, and the device's applied duty echoed on
 // <prefix>BRINGUP_DUTY_APPLIED per sample. What to do with each frame,
 // command and silence is hw::HwBridge's; this class only moves bytes and
-// messages and reports the heartbeat.
+// messages, verifies their MACs (node/message_auth.h) and reports the
+// heartbeat. It also hears the safety session's announcements
+// (supervisor_state_t) and the operator's RESET (operator_command_t), which
+// clears the bridge's tripped guard.
 #include <array>
 #include <cstdint>
 #include <lcm/lcm-cpp.hpp>
@@ -15,6 +18,7 @@
 #include "stewart/config/stack_config.h"
 #include "stewart/duty_command_t.hpp"
 #include "stewart/force_command_t.hpp"
+#include "stewart/guard/operator_command_check.h"
 #include "stewart/hw_bridge/bridge.h"
 #include "stewart/hw_bridge/host_clock.h"
 #include "stewart/hw_bridge/transport.h"
@@ -22,6 +26,9 @@
 #include "stewart/node/exit_code.h"
 #include "stewart/node/health_reporter.h"
 #include "stewart/node/lcm_receiver.h"
+#include "stewart/node/message_auth.h"
+#include "stewart/operator_command_t.hpp"
+#include "stewart/supervisor_state_t.hpp"
 
 namespace stewart {
 
@@ -40,6 +47,10 @@ class BridgeNode {
                  const force_command_t* msg);
   void OnDutyCommand(const lcm::ReceiveBuffer* rbuf, const std::string& channel,
                      const duty_command_t* msg);
+  void OnSupervisor(const lcm::ReceiveBuffer* rbuf, const std::string& channel,
+                    const supervisor_state_t* msg);
+  void OnOperator(const lcm::ReceiveBuffer* rbuf, const std::string& channel,
+                  const operator_command_t* msg);
   void PublishApplied();
   void SendCommand();
   void UpdateHealth();
@@ -49,6 +60,9 @@ class BridgeNode {
   LcmReceiver receiver_;
   hw::Transport* transport_;
   hw::HwBridge bridge_;
+  MessageAuthenticator auth_;
+  OperatorCommandCheck operator_check_;
+  int64_t guard_trips_logged_ = 0;
   HealthReporter health_;
   hw::HostClock clock_;
   hw::FrameReader reader_;

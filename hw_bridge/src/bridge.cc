@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "stewart/guard/guard_limits.h"
+
 namespace stewart::hw {
 namespace {
 constexpr int32_t kSensorStatusMask = 0x1F;  // DeviceStatus bits 0..4 = sensor_t.STATUS_*
@@ -13,12 +15,14 @@ bool SendsAtOnce(CommandVerdict verdict) {
 }
 
 HwBridge::HwBridge(const HwBridgeConfig& hw, double min_length_m, double stroke_m,
-                   double force_limit_n, const BringupOptions& bringup)
+                   double force_limit_n, const BringupOptions& bringup, const GuardConfig& guard)
     : hw_(hw),
       calibration_(hw, min_length_m, stroke_m),
       imu_(hw),
       drive_map_(hw, force_limit_n),
       clock_(hw.clock_drift_ppm),
+      acceptor_(AcceptorLimitsOf(guard, hw.command_timeout_s)),
+      actuator_guard_(ActuatorGuardLimitsOf(guard, min_length_m, min_length_m + stroke_m)),
       bringup_(bringup),
       guard_(bringup.guard) {}
 
@@ -75,10 +79,28 @@ bool HwBridge::OnSensorFrame(const SensorFrame& frame, int64_t host_rx_us, Senso
   have_sample_ = true;
   last_sample_seq_ = frame.seq;
   latest_sample_utime_ = utime;
+  acceptor_.OnSamplePublished(utime);
   tick_frame_due_ = !sent_since_sample_;
   sent_since_sample_ = false;
-  if (bringup_.enabled) UpdateBringup(frame, *sample);
+  if (bringup_.enabled) {
+    UpdateBringup(frame, *sample);
+  } else if (actuator_guard_.OnReadings(utime, sample->leg_length_m, PlausibleMask(frame))) {
+    // Tripped: the zero drive goes out with this sample, not with the next
+    // command.
+    tick_frame_due_ = true;
+  }
   return true;
+}
+
+uint8_t HwBridge::PlausibleMask(const SensorFrame& frame) const {
+  uint8_t plausible = 0;
+  for (int i = 0; i < kNumLegs; ++i) {
+    if (calibration_.Plausible(i, frame.adc[static_cast<std::size_t>(i)]) &&
+        ((frame.leg_fault_mask >> i) & 1U) == 0) {
+      plausible |= static_cast<uint8_t>(1U << i);
+    }
+  }
+  return plausible;
 }
 
 void HwBridge::UpdateBringup(const SensorFrame& frame, const SensorSample& sample) {
@@ -137,11 +159,28 @@ CommandVerdict HwBridge::AcceptCommand(int64_t utime, bool finite) {
   return CommandVerdict::kAccepted;
 }
 
-CommandVerdict HwBridge::OnForceCommand(int64_t utime, const Vector6d& force_n) {
+CommandVerdict HwBridge::OnSafeCommand(const ForceCommand& c, bool authentic) {
   if (bringup_.enabled) return CommandVerdict::kWrongMode;
-  const CommandVerdict verdict = AcceptCommand(utime, force_n.allFinite());
-  if (verdict == CommandVerdict::kAccepted) command_force_n_ = force_n;
+  last_rejection_ = acceptor_.Check(c, authentic);
+  if (last_rejection_ == CommandRejection::kNonFiniteForce) {
+    // The current session's own command, in order and fresh, but broken:
+    // zero drive at once rather than hold the previous one.
+    return AcceptCommand(c.sample_utime, false);
+  }
+  if (last_rejection_ != CommandRejection::kNone) return CommandVerdict::kUntrusted;
+  const CommandVerdict verdict = AcceptCommand(c.sample_utime, true);
+  if (verdict != CommandVerdict::kAccepted) return verdict;
+  command_drive_off_ = (c.flags & kCommandDriveOff) != 0;
+  command_force_n_ = command_drive_off_ ? Vector6d::Zero() : c.force_n;
+  // The last line: a force beyond the bound, whoever sent it, trips the
+  // guard; the frame this command triggers goes out with zero drive.
+  if (!command_drive_off_) actuator_guard_.OnForceCommand(c.force_n);
   return verdict;
+}
+
+GuardResetResult HwBridge::OnOperatorReset() {
+  if (bringup_.enabled) return GuardResetResult::kNotTripped;
+  return actuator_guard_.Reset();
 }
 
 CommandVerdict HwBridge::OnDutyCommand(int64_t utime, const Vector6d& duty) {
@@ -152,12 +191,14 @@ CommandVerdict HwBridge::OnDutyCommand(int64_t utime, const Vector6d& duty) {
 }
 
 DriveReason HwBridge::CurrentReason() const {
+  if (!bringup_.enabled && actuator_guard_.tripped()) return DriveReason::kGuard;
   if (command_invalid_) return DriveReason::kInvalid;
   if (!have_command_) return DriveReason::kMissing;
   // Age in stack time: how far the device's samples have moved on since the
   // sample this command was computed from.
   const double age_s = static_cast<double>(latest_sample_utime_ - command_utime_) * 1e-6;
   if (age_s > hw_.command_timeout_s) return DriveReason::kStale;
+  if (command_drive_off_) return DriveReason::kDriveOff;
   return DriveReason::kCommand;
 }
 
@@ -177,6 +218,8 @@ std::size_t HwBridge::BuildCommandFrame(int64_t host_now_us, uint8_t* out) {
       counters_.duty_clamped += (drive.duty_clamped_mask >> i) & 1U;
     }
   } else if (last_reason_ == DriveReason::kCommand) {
+    counters_.applied_age_max_us =
+        std::max(counters_.applied_age_max_us, latest_sample_utime_ - command_utime_);
     const DriveResult drive = drive_map_.ForceToDrive(command_force_n_);
     frame.drive = drive.drive;
     for (int i = 0; i < kNumLegs; ++i) {
@@ -188,6 +231,8 @@ std::size_t HwBridge::BuildCommandFrame(int64_t host_now_us, uint8_t* out) {
     // Zero drive: the P-16P's lead screw holds its length unpowered.
     frame.drive.fill(0);
     ++counters_.zero_drive_frames;
+    if (last_reason_ == DriveReason::kDriveOff) ++counters_.drive_off_frames;
+    if (last_reason_ == DriveReason::kGuard) ++counters_.guard_frames;
   }
   ++counters_.command_frames;
   sent_watchdog_us_ = frame.watchdog_us;
@@ -210,6 +255,11 @@ LinkHealth HwBridge::Health(int64_t host_now_us, const std::string& link_descrip
   }
   if (LinkDown(host_now_us)) {
     return {LinkState::kFault, "device link down: no sensor frame for > link_timeout_s"};
+  }
+  if (!bringup_.enabled && actuator_guard_.tripped()) {
+    return {LinkState::kFault, "guard tripped: " + actuator_guard_.Describe() +
+                                   "; zero drive (lead screws hold) until an operator RESET "
+                                   "with the readings back inside"};
   }
   if (last_reason_ != DriveReason::kCommand) {
     return {LinkState::kDegraded,

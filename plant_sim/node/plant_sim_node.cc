@@ -6,8 +6,10 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "stewart/guard/guard_limits.h"
 #include "stewart/node/eigen_msg.h"
 #include "stewart/node/node_loop.h"
+#include "stewart/node/signal_messages.h"
 #include "stewart/node/stop_signal.h"
 #include "stewart/plant_sim/lockstep_pacing.h"
 #include "stewart/plant_sim/real_time_pacing.h"
@@ -18,6 +20,17 @@ namespace stewart {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+
+int64_t WallMicros() {
+  return std::chrono::duration_cast<std::chrono::microseconds>(
+             std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+int64_t MonotonicMicros() {
+  return std::chrono::duration_cast<std::chrono::microseconds>(Clock::now().time_since_epoch())
+      .count();
+}
 
 int64_t PeriodUs(double rate_hz) {
   const int64_t period_us = std::llround(1e6 / rate_hz);
@@ -37,14 +50,26 @@ PlantSimNode::PlantSimNode(const StackConfig& config, const PlantTruth& truth, l
       sensors_(truth.sensors, truth.actuators, truth.platform.gravity_mps2, truth.sensor_errors),
       disturbance_(truth.disturbance, truth.sensors.seed),
       health_("plant_sim", config.lcm.channels.health, config.lcm.health_rate_hz),
-      hold_(config.plant_sim.command_timeout_s,
-            ParseTimeoutFallback(config.plant_sim.timeout_fallback)),
+      hold_(SecondsToMicros(config.plant_sim.command_timeout_s)),
+      auth_(MessageAuthenticator::FromKeyFile(config.lcm.auth_key_file)),
+      // The stroke the stack believes in (the config's), read by the plant's
+      // own pots: a truth with other legs shows up as it would on the device.
+      guard_(ActuatorGuardLimitsOf(config.guard, config.platform.leg_min_length_m,
+                                   config.platform.leg_max_length_m)),
+      operator_check_(SecondsToMicros(config.guard.operator_max_age_s)),
       period_us_(PeriodUs(config.sensors.rate_hz)),
-      gate_(options.mode == SimMode::kLockstep),
+      gate_(options.mode == SimMode::kLockstep,
+            AcceptorLimitsOf(config.guard, config.plant_sim.command_timeout_s)),
       latency_tracker_(0, period_us_),
       tick_accounting_(0, period_us_) {
   plant_.Reset(0.0, truth.initial_pose, truth.initial_velocity);
   receiver_.Subscribe(config.lcm.channels.command_safe, &PlantSimNode::HandleCommand, this);
+  receiver_.Subscribe(config.lcm.channels.supervisor, &PlantSimNode::HandleSupervisor, this);
+  receiver_.Subscribe(config.lcm.channels.operator_command, &PlantSimNode::HandleOperator, this);
+  spdlog::info(
+      "plant_sim: commands accepted from the safety session announced on {}{}",
+      config.lcm.channels.supervisor,
+      auth_.enabled() ? ", authenticated (lcm.auth_key_file)" : ", no key: not authenticated");
 }
 
 ExitCode PlantSimNode::Run() {
@@ -61,6 +86,7 @@ ExitCode PlantSimNode::Run() {
   }
   if (status == ExitCode::kOk) health_.SetState(health_t::STATE_STOPPED);
   UpdateLatencyCounters();
+  UpdateTrustCounters();
   health_.MaybePublish(lcm_, true);
   spdlog::info(
       "plant_sim: sample-to-command latency p50 {} us, p99 {} us, max {} us ({} answered "
@@ -105,6 +131,7 @@ void PlantSimNode::PublishSample() {
   lcm_->publish(config_.lcm.channels.sensors, &s);
   latency_tracker_.OnPublished(tick_, tick_utime_, Clock::now());
   gate_.OnSamplePublished(tick_utime_);
+  CheckGuard(r.leg_length_m);
 
   state_t truth{};
   truth.utime = tick_utime_;
@@ -129,32 +156,126 @@ void PlantSimNode::AdvanceTick() {
   health_.SetCounter("ticks", tick_ + 1);
   if (tick_ % 100 == 0) {
     UpdateLatencyCounters();
+    UpdateTrustCounters();
     ReportReceiverCounters(receiver_, &health_);
   }
+  UpdateHealthState();
   health_.MaybePublish(lcm_);
+}
+
+void PlantSimNode::CheckGuard(const Vector6d& leg_length_m) {
+  // plant_sim's pots have no fault model: every reading is plausible; a
+  // non-finite one still trips.
+  if (!guard_.OnReadings(tick_utime_, leg_length_m)) return;
+  guard_error_ = "guard tripped: " + guard_.Describe() +
+                 "; actuators off (lead screws hold) until an operator RESET with the readings "
+                 "back inside";
+  spdlog::error("plant_sim: t = {:.3f} s: {}", plant_.time_s(), guard_error_);
+  UpdateTrustCounters();
+  UpdateHealthState();
+}
+
+void PlantSimNode::UpdateHealthState() {
+  if (guard_.tripped()) {
+    health_.SetState(health_t::STATE_FAULT);
+    health_.SetError(guard_error_);
+  } else if (fallback_active_) {
+    health_.SetState(health_t::STATE_DEGRADED);
+  } else {
+    health_.SetState(health_t::STATE_OK);
+  }
+}
+
+void PlantSimNode::UpdateTrustCounters() {
+  const SafeCommandAcceptor& a = gate_.acceptor();
+  health_.SetCounter("safety_session", a.session_id());
+  health_.SetCounter("sessions_adopted", a.sessions_adopted());
+  health_.SetCounter("commands_trusted", a.accepted());
+  health_.SetCounter("applied_age_max_us", applied_age_max_us_);
+  health_.SetCounter("guard_tripped", guard_.tripped() ? 1 : 0);
+  health_.SetCounter("guard_trips", guard_.trips());
+  health_.SetCounter("guard_resets", guard_.resets_cleared());
+  health_.SetCounter("guard_resets_refused", guard_.resets_refused());
+  // How close the run came to the guard's limits, to size them: um, um/s, mN.
+  health_.SetCounter("guard_min_end_distance_um", std::llround(guard_.min_end_distance_m() * 1e6));
+  health_.SetCounter("guard_max_speed_umps", std::llround(guard_.max_speed_mps() * 1e6));
+  health_.SetCounter("guard_max_force_mn", std::llround(guard_.max_force_n() * 1e3));
 }
 
 void PlantSimNode::HandleCommand(const lcm::ReceiveBuffer*, const std::string&,
                                  const force_command_t* msg) {
   health_.CountIn();
-  const Vector6d force_n = FromArray(msg->force_n);
-  const CommandGate::Decision d = gate_.Check(force_n, msg->sample_utime, msg->seq);
+  const ForceCommand command = FromMessage(*msg);
+  const CommandGate::Decision d = gate_.Check(command, auth_.Verify(*msg));
   if (d.timed) {
     if (const auto latency_us =
             latency_tracker_.OnCommand(msg->sample_utime, tick_, Clock::now())) {
       latency_.Add(*latency_us);
     }
   }
-  switch (d.action) {
-    case CommandGate::Action::kReject:
-      health_.Reject(d.reason, d.detail);
-      return;
-    case CommandGate::Action::kAnswer:
-      return;
-    case CommandGate::Action::kApply:
-      hold_.OnCommand(force_n, plant_.time_s());
-      return;
+  if (d.action == CommandGate::Action::kReject) {
+    health_.Reject(d.reason, d.detail);
+    return;
   }
+  // The last line: a force beyond the guard's bound, whoever sent it, turns
+  // the drive off. A drive-off command carries no force to judge.
+  if ((command.flags & kCommandDriveOff) == 0 && guard_.OnForceCommand(command.force_n)) {
+    guard_error_ = "guard tripped: " + guard_.Describe() +
+                   "; actuators off (lead screws hold) until an operator RESET";
+    spdlog::error("plant_sim: t = {:.3f} s: {} (force_command_t seq {})", plant_.time_s(),
+                  guard_error_, msg->seq);
+    UpdateTrustCounters();
+    UpdateHealthState();
+  }
+  if (d.action == CommandGate::Action::kApply) {
+    hold_.OnCommand(command.force_n, command.sample_utime, (command.flags & kCommandDriveOff) != 0);
+  }
+}
+
+void PlantSimNode::HandleSupervisor(const lcm::ReceiveBuffer*, const std::string&,
+                                    const supervisor_state_t* msg) {
+  health_.CountIn();
+  const SessionAnnouncement a{msg->utime, msg->seq, msg->session_id};
+  const AnnouncementVerdict v = gate_.OnAnnouncement(a, auth_.Verify(*msg), MonotonicMicros());
+  if (IsRejection(v)) {
+    health_.Reject(ToString(v), "supervisor_state_t session " + std::to_string(msg->session_id) +
+                                    ", seq " + std::to_string(msg->seq) + ", utime " +
+                                    std::to_string(msg->utime) + " (newest sample " +
+                                    std::to_string(tick_utime_) + ")");
+    return;
+  }
+  if (v == AnnouncementVerdict::kAdopted) {
+    spdlog::info("plant_sim: following safety session {} (announced at utime {})", msg->session_id,
+                 msg->utime);
+    UpdateTrustCounters();
+  }
+}
+
+void PlantSimNode::HandleOperator(const lcm::ReceiveBuffer*, const std::string&,
+                                  const operator_command_t* msg) {
+  // Only RESET concerns the plant; the supervisor judges the rest.
+  if (msg->command != operator_command_t::COMMAND_RESET) return;
+  health_.CountIn();
+  const OperatorVerdict v = operator_check_.Check(msg->operator_id, msg->seq, msg->utime,
+                                                  auth_.Verify(*msg), WallMicros());
+  if (v != OperatorVerdict::kAccepted) {
+    health_.Reject(ToString(v), "operator_command_t RESET from " +
+                                    std::to_string(msg->operator_id) + ", seq " +
+                                    std::to_string(msg->seq));
+    return;
+  }
+  const bool was_tripped = guard_.tripped();
+  const GuardResetResult r = guard_.Reset();
+  if (r == GuardResetResult::kCleared) {
+    spdlog::warn("plant_sim: guard cleared by operator {} (was: {})", msg->operator_id,
+                 guard_error_);
+    guard_error_.clear();
+    health_.SetError("");
+  } else if (was_tripped) {
+    spdlog::warn("plant_sim: operator RESET refused: readings not back inside ({})", guard_error_);
+  }
+  UpdateTrustCounters();
+  UpdateHealthState();
 }
 
 void PlantSimNode::UpdateLatencyCounters() {
@@ -177,22 +298,23 @@ void PlantSimNode::UpdateTickCounters() {
 }
 
 void PlantSimNode::ApplyRealTimeDecision() {
-  const RealTimeCommandHold::Decision d = hold_.Decide(plant_.time_s());
-  plant_.SetActuatorsOff(d.actuators_off);
-  if (!d.actuators_off) plant_.SetForceCommand(d.force_cmd_n);
+  const RealTimeCommandHold::Decision d = hold_.Decide(tick_utime_);
+  const bool off = d.actuators_off || guard_.tripped();
+  plant_.SetActuatorsOff(off);
+  if (!off) {
+    plant_.SetForceCommand(d.force_cmd_n);
+    applied_age_max_us_ = std::max(applied_age_max_us_, d.age_us);
+  }
   if (d.timed_out != fallback_active_) {
     fallback_active_ = d.timed_out;
     if (d.timed_out) {
-      const std::string what =
-          d.actuators_off ? "actuators off, lead screws hold the legs" : "holding the last command";
-      health_.SetError("no force_command_t on " + config_.lcm.channels.command_safe + " for " +
-                       std::to_string(config_.plant_sim.command_timeout_s) + " s: " + what);
-      health_.SetState(health_t::STATE_DEGRADED);
+      health_.SetError("no force_command_t on " + config_.lcm.channels.command_safe +
+                       " younger than " + std::to_string(config_.plant_sim.command_timeout_s) +
+                       " s: actuators off, lead screws hold the legs");
       health_.Count("command_timeouts");
-      spdlog::warn("plant_sim: command timeout at t = {:.3f} s: {}", plant_.time_s(), what);
+      spdlog::warn("plant_sim: command timeout at t = {:.3f} s: actuators off", plant_.time_s());
     } else {
       health_.SetError("");
-      health_.SetState(health_t::STATE_OK);
       spdlog::info("plant_sim: commands resumed at t = {:.3f} s", plant_.time_s());
     }
   }
@@ -263,7 +385,12 @@ ExitCode PlantSimNode::RunLockstep() {
       receiver_.HandleTimeout(step.wait_ms);
       health_.MaybePublish(lcm_);
     }
-    plant_.SetForceCommand(gate_.answer_force_n());
+    // The answer moves the loop on; a drive-off answer or a tripped guard
+    // leaves the actuators off for this period (the lead screws hold).
+    const ForceCommand& answer = gate_.answer();
+    const bool off = guard_.tripped() || (answer.flags & kCommandDriveOff) != 0;
+    plant_.SetActuatorsOff(off);
+    if (!off) plant_.SetForceCommand(answer.force_n);
     AdvanceTick();
   }
   return ExitCode::kOk;

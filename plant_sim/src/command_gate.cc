@@ -5,12 +5,12 @@
 namespace stewart {
 namespace {
 
-CommandGate::Decision Reject(std::string reason, std::string detail) {
+CommandGate::Decision Reject(std::string reason, std::string detail, bool timed) {
   CommandGate::Decision d;
   d.action = CommandGate::Action::kReject;
   d.reason = std::move(reason);
   d.detail = std::move(detail);
-  d.timed = true;
+  d.timed = timed;
   return d;
 }
 
@@ -23,37 +23,43 @@ CommandGate::Decision Accept(CommandGate::Action action) {
 
 }  // namespace
 
+CommandGate::CommandGate(bool lockstep, const SafeCommandAcceptorLimits& limits)
+    : lockstep_(lockstep), acceptor_(limits) {}
+
 void CommandGate::OnSamplePublished(int64_t sample_utime) {
   newest_sample_utime_ = sample_utime;
+  acceptor_.OnSamplePublished(sample_utime);
   answered_ = false;
 }
 
-CommandGate::Decision CommandGate::Check(const Vector6d& force_n, int64_t sample_utime,
-                                         int64_t seq) {
-  const std::string problem = ForceCommandProblem(force_n);
-  if (!problem.empty()) {
-    Decision d = Reject(problem, "force_command_t seq " + std::to_string(seq));
-    d.timed = false;
-    return d;
+CommandGate::Decision CommandGate::Check(const ForceCommand& c, bool authentic) {
+  const CommandRejection trust = acceptor_.Check(c, authentic);
+  if (trust != CommandRejection::kNone) {
+    return Reject(ToString(trust),
+                  "force_command_t seq " + std::to_string(c.seq) + ", session " +
+                      std::to_string(c.session_id) + ", sample_utime " +
+                      std::to_string(c.sample_utime) + " (following session " +
+                      std::to_string(acceptor_.session_id()) + ", newest sample " +
+                      std::to_string(newest_sample_utime_) + ")",
+                  false);
   }
-  const std::string utime = std::to_string(sample_utime);
+  const std::string utime = std::to_string(c.sample_utime);
   const std::string awaited = std::to_string(newest_sample_utime_);
   if (lockstep_) {
-    switch (MatchLockstepCommand(newest_sample_utime_, sample_utime)) {
+    switch (MatchLockstepCommand(newest_sample_utime_, c.sample_utime)) {
       case LockstepMatch::kAnswer:
-        if (answered_) return Reject("duplicate_answer", "sample_utime " + utime);
+        if (answered_) return Reject("duplicate_answer", "sample_utime " + utime, true);
         answered_ = true;
-        answer_force_n_ = force_n;
+        answer_ = c;
         return Accept(Action::kAnswer);
       case LockstepMatch::kStale:
-        return Reject("stale_sample_utime", utime + " < awaited " + awaited);
+        return Reject("stale_sample_utime", utime + " < awaited " + awaited, true);
       case LockstepMatch::kFuture:
-        return Reject("future_sample_utime", utime + " > awaited " + awaited);
+        return Reject("future_sample_utime", utime + " > awaited " + awaited, true);
     }
   }
-  if (sample_utime > newest_sample_utime_) return Reject("future_sample_utime", utime);
-  if (sample_utime < last_applied_sample_utime_) return Reject("out_of_order", utime);
-  last_applied_sample_utime_ = sample_utime;
+  if (c.sample_utime < last_applied_sample_utime_) return Reject("out_of_order", utime, true);
+  last_applied_sample_utime_ = c.sample_utime;
   return Accept(Action::kApply);
 }
 

@@ -1,42 +1,37 @@
 #include "stewart/plant_sim/command_policy.h"
 
-#include <stdexcept>
+#include "stewart/common/check.h"
 
 namespace stewart {
-
-TimeoutFallback ParseTimeoutFallback(const std::string& name) {
-  if (name == "off") return TimeoutFallback::kActuatorsOff;
-  if (name == "hold_last") return TimeoutFallback::kHoldLast;
-  throw std::invalid_argument("unknown timeout fallback '" + name + "' (off | hold_last)");
-}
 
 std::string ForceCommandProblem(const Vector6d& force_n) {
   if (!force_n.allFinite()) return "non_finite_force";
   return "";
 }
 
-RealTimeCommandHold::RealTimeCommandHold(double command_timeout_s, TimeoutFallback fallback)
-    : timeout_s_(command_timeout_s), fallback_(fallback) {}
+RealTimeCommandHold::RealTimeCommandHold(int64_t max_age_us) : max_age_us_(max_age_us) {
+  STEWART_CHECK(max_age_us > 0, "RealTimeCommandHold: max_age_us must be positive");
+}
 
-void RealTimeCommandHold::OnCommand(const Vector6d& force_n, double now_s) {
+void RealTimeCommandHold::OnCommand(const Vector6d& force_n, int64_t sample_utime, bool drive_off) {
   have_command_ = true;
-  last_command_s_ = now_s;
+  sample_utime_ = sample_utime;
+  drive_off_ = drive_off;
   last_force_n_ = force_n;
 }
 
-RealTimeCommandHold::Decision RealTimeCommandHold::Decide(double now_s) const {
+RealTimeCommandHold::Decision RealTimeCommandHold::Decide(int64_t tick_sample_utime) const {
   Decision d;
-  d.timed_out = !have_command_ || now_s - last_command_s_ > timeout_s_;
-  if (!d.timed_out) {
-    d.force_cmd_n = last_force_n_;
+  const int64_t age_us = tick_sample_utime - sample_utime_;
+  d.timed_out = !have_command_ || age_us > max_age_us_;
+  if (d.timed_out || drive_off_) {
+    // Nothing young enough to apply, or the supervisor's drive off: the
+    // motors are unpowered and the lead screws hold every leg.
+    d.actuators_off = true;
     return d;
   }
-  // Before the first command there is nothing to hold: the motors are unpowered.
-  if (fallback_ == TimeoutFallback::kHoldLast && have_command_) {
-    d.force_cmd_n = last_force_n_;
-  } else {
-    d.actuators_off = true;
-  }
+  d.force_cmd_n = last_force_n_;
+  d.age_us = age_us;
   return d;
 }
 

@@ -7,6 +7,26 @@
 namespace stewart::hw {
 namespace {
 
+constexpr int64_t kSession = 77;
+
+/// A safe command of session kSession, announced first when the bridge
+/// follows no session yet (the safety process does the same before its
+/// first command). seq increases over the whole test binary.
+CommandVerdict Command(HwBridge& bridge, int64_t sample_utime, const Vector6d& force,
+                       int32_t flags = 0) {
+  static int64_t seq = 0;
+  if (!bridge.acceptor().has_session()) {
+    bridge.OnAnnouncement({bridge.latest_sample_utime(), 1, kSession}, true, 0);
+  }
+  ForceCommand c;
+  c.utime = c.sample_utime = sample_utime;
+  c.seq = ++seq;
+  c.force_n = force;
+  c.flags = flags;
+  c.session_id = kSession;
+  return bridge.OnSafeCommand(c, true);
+}
+
 class BridgeTest : public ::testing::Test {
  protected:
   BridgeTest()
@@ -81,7 +101,7 @@ TEST_F(BridgeTest, FreshCommandIsMappedAndStaleOneZeroed) {
   Deliver(0);
   Deliver(1);
   const Vector6d force = Vector6d::Constant(20.0);
-  ASSERT_EQ(bridge_.OnForceCommand(sample_.utime, force), CommandVerdict::kAccepted);
+  ASSERT_EQ(Command(bridge_, sample_.utime, force), CommandVerdict::kAccepted);
   DecodedFrame f = Send();
   EXPECT_EQ(bridge_.last_reason(), DriveReason::kCommand);
   const DriveResult expected = DriveMap(hw_, 100.0).ForceToDrive(force);
@@ -110,7 +130,7 @@ TEST_F(BridgeTest, ForcesInTheDeadZoneAreCounted) {
   Vector6d force = Vector6d::Constant(2.0);
   force(1) = 0.3;
   force(4) = -0.2;
-  ASSERT_EQ(bridge.OnForceCommand(sample.utime, force), CommandVerdict::kAccepted);
+  ASSERT_EQ(Command(bridge, sample.utime, force), CommandVerdict::kAccepted);
   std::array<uint8_t, kMaxFrameSize> buffer{};
   bridge.BuildCommandFrame(kHostEpoch, buffer.data());
   bridge.BuildCommandFrame(kHostEpoch + 500, buffer.data());
@@ -120,30 +140,32 @@ TEST_F(BridgeTest, ForcesInTheDeadZoneAreCounted) {
 
 TEST_F(BridgeTest, NonFiniteCommandZeroesUntilAValidOne) {
   Deliver(0);
-  ASSERT_EQ(bridge_.OnForceCommand(sample_.utime, Vector6d::Constant(10.0)),
-            CommandVerdict::kAccepted);
+  ASSERT_EQ(Command(bridge_, sample_.utime, Vector6d::Constant(10.0)), CommandVerdict::kAccepted);
   Vector6d bad = Vector6d::Constant(10.0);
   bad(4) = std::nan("");
-  EXPECT_EQ(bridge_.OnForceCommand(sample_.utime, bad), CommandVerdict::kNonFinite);
+  EXPECT_EQ(Command(bridge_, sample_.utime, bad), CommandVerdict::kNonFinite);
   DecodedFrame f = Send();
   EXPECT_EQ(bridge_.last_reason(), DriveReason::kInvalid);
   for (int16_t d : f.command.drive) EXPECT_EQ(d, 0);
-  ASSERT_EQ(bridge_.OnForceCommand(sample_.utime, Vector6d::Constant(10.0)),
-            CommandVerdict::kAccepted);
+  ASSERT_EQ(Command(bridge_, sample_.utime, Vector6d::Constant(10.0)), CommandVerdict::kAccepted);
   f = Send();
   EXPECT_EQ(bridge_.last_reason(), DriveReason::kCommand);
   EXPECT_GT(f.command.drive[0], 0);
 }
 
 TEST_F(BridgeTest, CommandsFromAnotherTimeBaseOrOutOfOrderAreIgnored) {
-  EXPECT_EQ(bridge_.OnForceCommand(5, Vector6d::Zero()), CommandVerdict::kFuture);  // no sample
+  // No sample yet: no session can be announced, so nothing is trusted.
+  EXPECT_EQ(Command(bridge_, 5, Vector6d::Zero()), CommandVerdict::kUntrusted);
+  EXPECT_EQ(bridge_.last_rejection(), CommandRejection::kNoSession);
   Deliver(0);
   Deliver(1);
-  EXPECT_EQ(bridge_.OnForceCommand(sample_.utime + 10'000'000, Vector6d::Zero()),
-            CommandVerdict::kFuture);
-  ASSERT_EQ(bridge_.OnForceCommand(sample_.utime, Vector6d::Constant(5.0)),
-            CommandVerdict::kAccepted);
-  EXPECT_EQ(bridge_.OnForceCommand(sample_.utime - 1000, Vector6d::Constant(50.0)),
+  EXPECT_EQ(Command(bridge_, sample_.utime + 10'000'000, Vector6d::Zero()),
+            CommandVerdict::kUntrusted);
+  EXPECT_EQ(bridge_.last_rejection(), CommandRejection::kFutureSample);
+  // Never ahead of the newest sample, not even by one microsecond.
+  EXPECT_EQ(Command(bridge_, sample_.utime + 1, Vector6d::Zero()), CommandVerdict::kUntrusted);
+  ASSERT_EQ(Command(bridge_, sample_.utime, Vector6d::Constant(5.0)), CommandVerdict::kAccepted);
+  EXPECT_EQ(Command(bridge_, sample_.utime - 1000, Vector6d::Constant(50.0)),
             CommandVerdict::kOutOfOrder);
   EXPECT_EQ(Send().command.drive, DriveMap(hw_, 100.0).ForceToDrive(Vector6d::Constant(5.0)).drive);
 }
@@ -222,8 +244,7 @@ TEST_F(BridgeTest, HealthReportsTheWorstConditionFirst) {
   EXPECT_EQ(h.state, LinkState::kDegraded);
   EXPECT_EQ(h.error, "zero drive: missing safe command");
 
-  ASSERT_EQ(bridge_.OnForceCommand(sample_.utime, Vector6d::Constant(10.0)),
-            CommandVerdict::kAccepted);
+  ASSERT_EQ(Command(bridge_, sample_.utime, Vector6d::Constant(10.0)), CommandVerdict::kAccepted);
   Send();
   h = bridge_.Health(host_now_, "udp test");
   EXPECT_EQ(h.state, LinkState::kOk);

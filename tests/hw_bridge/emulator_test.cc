@@ -240,7 +240,8 @@ void ExpectBridgePlusEmulatorEqualsPlantSim(const StackConfig& c, const SwapCont
   DeviceEmulator device(&backend);
   HwBridge bridge(c.hw_bridge, c.platform.leg_min_length_m,
                   c.platform.leg_max_length_m - c.platform.leg_min_length_m,
-                  c.actuators.force_limit_n);
+                  c.actuators.force_limit_n, {}, c.guard);
+  constexpr int64_t kSession = 5;  // the safety session the commands come from
   // plant_sim's library, as its node uses it (legs locked until the first command).
   OdeOptions ode;
   ode.rel_tol = c.plant_sim.rel_tol;
@@ -311,7 +312,16 @@ void ExpectBridgePlusEmulatorEqualsPlantSim(const StackConfig& c, const SwapCont
     const Vector6d f_emu = control(backend.q(), backend.qd(), t_s);
     const Vector6d f_sim = control(plant.q(), plant.qd(), t_s);
     min_force = std::min(min_force, f_emu.cwiseAbs().minCoeff());
-    ASSERT_EQ(bridge.OnForceCommand(sample.utime, f_emu), CommandVerdict::kAccepted);
+    if (k == 0) {
+      ASSERT_EQ(bridge.OnAnnouncement({sample.utime, 1, kSession}, true, 0),
+                AnnouncementVerdict::kAdopted);
+    }
+    ForceCommand command_emu;
+    command_emu.utime = command_emu.sample_utime = sample.utime;
+    command_emu.seq = k;
+    command_emu.force_n = f_emu;
+    command_emu.session_id = kSession;
+    ASSERT_EQ(bridge.OnSafeCommand(command_emu, true), CommandVerdict::kAccepted);
     std::array<uint8_t, kMaxFrameSize> buffer{};
     const std::size_t size = bridge.BuildCommandFrame(sample.utime, buffer.data());
     DecodedFrame command;

@@ -20,6 +20,7 @@
 #include "stewart/node/lcm_handle.h"
 #include "stewart/sensor_t.hpp"
 #include "stewart/test_support/child_process.h"
+#include "stewart/test_support/fake_safety_session.h"
 
 extern char** environ;
 
@@ -33,6 +34,8 @@ class Stack {
   explicit Stack(int lcm_port) : config_(LoadStackConfig(DefaultConfigPath())) {
     config_.lcm.url = PrivateLcmUrl(lcm_port);
     lcm_ = MakeLcm(config_.lcm.url);
+    safety_ = std::make_unique<test::FakeSafetySession>(lcm_.get(), config_.lcm.channels.supervisor,
+                                                        config_.lcm.channels.command_safe);
     lcm_->subscribe(config_.lcm.channels.sensors, &Stack::OnSensor, this)->setQueueCapacity(1000);
     lcm_->subscribe(config_.lcm.channels.health, &Stack::OnHealth, this);
     const DynamicsTerms terms =
@@ -59,20 +62,19 @@ class Stack {
     if (!command_) return;
     force_command_t cmd{};
     cmd.utime = msg->utime;
-    cmd.seq = seq_++;
     cmd.sample_utime = msg->utime;
     for (int i = 0; i < 6; ++i) cmd.force_n[i] = f_hold_(i) + extra_n_;
-    lcm_->publish(config_.lcm.channels.command_safe, &cmd);
+    safety_->Publish(cmd);
   }
   void OnHealth(const lcm::ReceiveBuffer*, const std::string&, const health_t* msg) {
     if (msg->name == "hw_bridge") health.push_back(*msg);
   }
 
   std::unique_ptr<lcm::LCM> lcm_;
+  std::unique_ptr<test::FakeSafetySession> safety_;
   Vector6d f_hold_;
   bool command_ = false;
   double extra_n_ = 0.0;
-  int64_t seq_ = 0;
 };
 
 int64_t Counter(const health_t& h, const std::string& name) {
@@ -145,16 +147,19 @@ void ExerciseLink(Stack* stack, bool expect_lost) {
       << std::chrono::duration<double>(std::chrono::steady_clock::now() - hold_start).count()
       << " s";
   const double before = MeanLegLength(stack->sensors, held - 50, held);
-  // +0.5 N on every leg for 0.1 s (~3 m/s^2 up), then commands stop: the
-  // bridge goes stale after command_timeout_s and the locked legs hold.
-  // The push lasts 100 device samples (each answered by a command), not
-  // 0.1 s of wall time: a loaded machine may stall the link for a while, and
-  // the test is about the effect of the commands, not the link's speed.
+  // +0.06 N on every leg for 0.3 s, then commands stop: the bridge goes
+  // stale after command_timeout_s and the locked legs hold. Against the legs'
+  // friction (2 N s/m) the legs rise at up to 30 mm/s, under the bridge's
+  // guard (guard.leg_speed_cap_mps, 50 mm/s; a harder push trips it: the
+  // trust test). The push lasts 300 device samples (each answered by a
+  // command), not 0.3 s of wall time: a loaded machine may stall the link
+  // for a while, and the test is about the effect of the commands, not the
+  // link's speed.
   const std::size_t push_start = stack->sensors.size();
-  const auto push_deadline = std::chrono::steady_clock::now() + std::chrono::seconds(2);
-  while (stack->sensors.size() < push_start + 100 &&
+  const auto push_deadline = std::chrono::steady_clock::now() + std::chrono::seconds(3);
+  while (stack->sensors.size() < push_start + 300 &&
          std::chrono::steady_clock::now() < push_deadline) {
-    stack->Run(0.005, true, 0.5);
+    stack->Run(0.005, true, 0.06);
   }
   const std::size_t health_at_stop = stack->health.size();
   // Commands stopped: at least 0.8 s (past command_timeout_s) and 300 more
@@ -189,6 +194,7 @@ void ExerciseLink(Stack* stack, bool expect_lost) {
   EXPECT_EQ(Counter(h, "zero_drive"), 1);
   EXPECT_GT(Counter(h, "zero_drive_frames"), 50);
   EXPECT_GT(Counter(h, "commands_accepted"), 100);
+  EXPECT_EQ(Counter(h, "guard_trips"), 0);
   EXPECT_EQ(Counter(h, "corrupt_frames"), 0);
   if (expect_lost) {
     EXPECT_GT(Counter(h, "lost_frames"), 0);

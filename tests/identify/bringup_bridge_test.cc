@@ -89,8 +89,10 @@ TEST_F(BringupBridgeTest, TakesDutyCommandsAndRefusesForceCommands) {
 
   for (uint32_t k = 0; k < 30; ++k) ASSERT_TRUE(Deliver(k));
   EXPECT_TRUE(bridge_.bringup());
-  EXPECT_EQ(bridge_.OnForceCommand(sample_.utime, Vector6d::Constant(5.0)),
-            CommandVerdict::kWrongMode);
+  ForceCommand force;
+  force.utime = force.sample_utime = sample_.utime;
+  force.force_n = Vector6d::Constant(5.0);
+  EXPECT_EQ(bridge_.OnSafeCommand(force, true), CommandVerdict::kWrongMode);
   Vector6d duty;
   duty << 0.5, -0.25, 0.0, 1.5, NAN, -1.0;
   EXPECT_EQ(bridge_.OnDutyCommand(sample_.utime, duty), CommandVerdict::kNonFinite);

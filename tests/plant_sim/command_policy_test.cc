@@ -4,7 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstring>
+#include <stdexcept>
 #include <vector>
 
 #include "plant_test_util.h"
@@ -16,37 +18,50 @@ namespace {
 
 using test::Config;
 
-TEST(RealTimeCommandHold, HoldsThenFallsBackToActuatorsOff) {
-  RealTimeCommandHold hold(0.05, TimeoutFallback::kActuatorsOff);
-  EXPECT_TRUE(hold.Decide(0.0).actuators_off);  // nothing received yet
+TEST(RealTimeCommandHold, HoldsWhileYoungThenActuatorsOff) {
+  RealTimeCommandHold hold(50'000);
+  EXPECT_TRUE(hold.Decide(0).actuators_off);  // nothing received yet
+  EXPECT_TRUE(hold.Decide(0).timed_out);
   const Vector6d f = Vector6d::Constant(7.0);
-  hold.OnCommand(f, 1.0);
-  auto d = hold.Decide(1.049);
+  hold.OnCommand(f, 1'000'000, false);
+  auto d = hold.Decide(1'050'000);  // exactly the age limit: still applied
   EXPECT_FALSE(d.timed_out);
   EXPECT_FALSE(d.actuators_off);
   EXPECT_EQ(d.force_cmd_n, f);
-  d = hold.Decide(1.051);
+  EXPECT_EQ(d.age_us, 50'000);
+  d = hold.Decide(1'050'001);
   EXPECT_TRUE(d.timed_out);
   EXPECT_TRUE(d.actuators_off);
   EXPECT_EQ(d.force_cmd_n, Vector6d::Zero());
-  hold.OnCommand(2 * f, 1.06);  // recovers on the next command
-  EXPECT_EQ(hold.Decide(1.07).force_cmd_n, 2 * f);
-  EXPECT_FALSE(hold.Decide(1.07).actuators_off);
+  EXPECT_EQ(d.age_us, -1);
+  hold.OnCommand(2 * f, 1'060'000, false);  // recovers on the next command
+  EXPECT_EQ(hold.Decide(1'070'000).force_cmd_n, 2 * f);
+  EXPECT_FALSE(hold.Decide(1'070'000).actuators_off);
 }
 
-TEST(RealTimeCommandHold, HoldLastKeepsTheCommand) {
-  RealTimeCommandHold hold(0.05, TimeoutFallback::kHoldLast);
-  const Vector6d f = Vector6d::Constant(7.0);
-  hold.OnCommand(f, 0.0);
-  const auto d = hold.Decide(1.0);
+// The age is the command's own sample against the tick's, not when it came
+// in: a command that arrives now but was computed from a sample 0.4 s old
+// (an estimator that was stopped) is never applied.
+TEST(RealTimeCommandHold, AnOldCommandArrivingNowIsNotApplied) {
+  RealTimeCommandHold hold(50'000);
+  hold.OnCommand(Vector6d::Constant(3.0), 600'000, false);
+  const auto d = hold.Decide(1'000'000);
   EXPECT_TRUE(d.timed_out);
-  EXPECT_FALSE(d.actuators_off);
-  EXPECT_EQ(d.force_cmd_n, f);
+  EXPECT_TRUE(d.actuators_off);
+}
+
+TEST(RealTimeCommandHold, DriveOffTurnsTheActuatorsOffWithoutATimeout) {
+  RealTimeCommandHold hold(50'000);
+  hold.OnCommand(Vector6d::Zero(), 1000, true);
+  const auto d = hold.Decide(2000);
+  EXPECT_FALSE(d.timed_out);
+  EXPECT_TRUE(d.actuators_off);
+  hold.OnCommand(Vector6d::Constant(1.0), 2000, false);
+  EXPECT_FALSE(hold.Decide(3000).actuators_off);
+  EXPECT_THROW(RealTimeCommandHold(0), std::logic_error);
 }
 
 TEST(CommandPolicy, ParsingAndValidation) {
-  EXPECT_EQ(ParseTimeoutFallback("off"), TimeoutFallback::kActuatorsOff);
-  EXPECT_THROW(ParseTimeoutFallback("brake"), std::invalid_argument);
   Vector6d f = Vector6d::Zero();
   EXPECT_EQ(ForceCommandProblem(f), "");
   f(3) = std::nan("");
@@ -63,14 +78,15 @@ TEST(RealTimeCommandHold, TimeoutLocksThePlant) {
   Plant plant(model, test::OdeOptionsFor("arkode_erk"));
   const Vector6d q0 = Config().plant_sim.initial_pose;
   plant.Reset(0.0, q0, Vector6d::Zero());
-  RealTimeCommandHold hold(Config().plant_sim.command_timeout_s, TimeoutFallback::kActuatorsOff);
+  RealTimeCommandHold hold(std::llround(Config().plant_sim.command_timeout_s * 1e6));
   const Vector6d push = test::HoldingForce(model.platform, q0) + Vector6d::Constant(2.0);
   Vector6d l_at_timeout = Vector6d::Zero();
   bool timed_out_seen = false;
   for (int k = 0; k < 600; ++k) {
     const double t = k * 1e-3;
-    if (t < 0.2) hold.OnCommand(push, t);
-    const auto d = hold.Decide(t);
+    const int64_t utime = k * 1000;
+    if (t < 0.2) hold.OnCommand(push, utime, false);
+    const auto d = hold.Decide(utime);
     if (d.timed_out && !timed_out_seen) {
       timed_out_seen = true;
       EXPECT_NEAR(t, 0.2 + Config().plant_sim.command_timeout_s, 2e-3);

@@ -22,71 +22,126 @@ using std::chrono::milliseconds;
 using Action = CommandGate::Action;
 
 const Vector6d kForce = Vector6d::Constant(3.0);
+constexpr int64_t kSession = 42;
+
+/// A gate following session kSession, announced at `utime` (a sample the
+/// gate has published).
+CommandGate TrustingGate(bool lockstep, int64_t utime) {
+  CommandGate gate(lockstep, SafeCommandAcceptorLimits{});
+  gate.OnSamplePublished(utime);
+  EXPECT_EQ(gate.OnAnnouncement({utime, 1, kSession}, true, 0), AnnouncementVerdict::kAdopted);
+  return gate;
+}
+
+ForceCommand Command(int64_t sample_utime, int64_t seq, const Vector6d& force = kForce) {
+  ForceCommand c;
+  c.utime = c.sample_utime = sample_utime;
+  c.seq = seq;
+  c.force_n = force;
+  c.session_id = kSession;
+  return c;
+}
 
 TEST(CommandGate, NonFiniteForceIsRejectedAndNotTimed) {
-  CommandGate gate(false);
-  gate.OnSamplePublished(1000);
+  CommandGate gate = TrustingGate(false, 1000);
   Vector6d bad = kForce;
   bad(2) = std::numeric_limits<double>::quiet_NaN();
-  const CommandGate::Decision d = gate.Check(bad, 1000, 17);
+  const CommandGate::Decision d = gate.Check(Command(1000, 17, bad), true);
   EXPECT_EQ(d.action, Action::kReject);
   EXPECT_EQ(d.reason, "non_finite_force");
-  EXPECT_EQ(d.detail, "force_command_t seq 17");
+  EXPECT_NE(d.detail.find("force_command_t seq 17"), std::string::npos) << d.detail;
   EXPECT_FALSE(d.timed);
   EXPECT_EQ(gate.last_applied_sample_utime(), -1);
 }
 
-TEST(CommandGate, RealTimeAppliesInOrderAndRefusesFutureAndOlder) {
-  CommandGate gate(false);
-  gate.OnSamplePublished(2000);
-  CommandGate::Decision d = gate.Check(kForce, 3000, 1);
-  EXPECT_EQ(d.action, Action::kReject);
-  EXPECT_EQ(d.reason, "future_sample_utime");
-  EXPECT_EQ(d.detail, "3000");
-  EXPECT_TRUE(d.timed);
+TEST(CommandGate, UntrustedCommandsAreRejectedAndNotTimed) {
+  CommandGate gate(false, SafeCommandAcceptorLimits{});
+  gate.OnSamplePublished(1000);
+  CommandGate::Decision d = gate.Check(Command(1000, 1), true);
+  EXPECT_EQ(d.reason, "command_no_session");
+  EXPECT_FALSE(d.timed);
+  ASSERT_EQ(gate.OnAnnouncement({1000, 1, kSession}, true, 0), AnnouncementVerdict::kAdopted);
+  ForceCommand other = Command(1000, 2);
+  other.session_id = kSession + 1;
+  d = gate.Check(other, true);
+  EXPECT_EQ(d.reason, "command_wrong_session");
+  d = gate.Check(Command(1000, 3), false);
+  EXPECT_EQ(d.reason, "command_unauthentic");
+  EXPECT_FALSE(d.timed);
+  EXPECT_EQ(gate.Check(Command(1000, 4), true).action, Action::kApply);
+  EXPECT_EQ(gate.Check(Command(1000, 4), true).reason, "command_seq_not_increasing");
+}
 
-  d = gate.Check(kForce, 2000, 2);
+TEST(CommandGate, RealTimeAppliesInOrderAndRefusesFutureOlderAndStale) {
+  CommandGate gate = TrustingGate(false, 2000);
+  CommandGate::Decision d = gate.Check(Command(3000, 1), true);
+  EXPECT_EQ(d.action, Action::kReject);
+  EXPECT_EQ(d.reason, "command_future_sample");
+  EXPECT_FALSE(d.timed);
+
+  d = gate.Check(Command(2000, 2), true);
   EXPECT_EQ(d.action, Action::kApply);
   EXPECT_EQ(gate.last_applied_sample_utime(), 2000);
-  d = gate.Check(kForce, 2000, 3);  // a second command for the same sample still applies
+  d = gate.Check(Command(2000, 3), true);  // a second command for the same sample still applies
   EXPECT_EQ(d.action, Action::kApply);
 
-  d = gate.Check(kForce, 1000, 4);
+  d = gate.Check(Command(1000, 4), true);
   EXPECT_EQ(d.action, Action::kReject);
   EXPECT_EQ(d.reason, "out_of_order");
   EXPECT_EQ(d.detail, "1000");
   EXPECT_EQ(gate.last_applied_sample_utime(), 2000);
+
+  // Older than the command age limit against the newest sample: never applied.
+  gate.OnSamplePublished(2000 + SafeCommandAcceptorLimits{}.command_max_age_us + 1);
+  d = gate.Check(Command(2000, 5), true);
+  EXPECT_EQ(d.reason, "command_stale_sample");
 }
 
 TEST(CommandGate, LockstepTakesTheFirstAnswerOnly) {
-  CommandGate gate(true);
-  gate.OnSamplePublished(5000);
+  CommandGate gate = TrustingGate(true, 5000);
   EXPECT_FALSE(gate.answered());
 
-  CommandGate::Decision d = gate.Check(kForce, 4000, 1);
+  CommandGate::Decision d = gate.Check(Command(4000, 1), true);
   EXPECT_EQ(d.action, Action::kReject);
   EXPECT_EQ(d.reason, "stale_sample_utime");
   EXPECT_EQ(d.detail, "4000 < awaited 5000");
-  d = gate.Check(kForce, 6000, 2);
-  EXPECT_EQ(d.reason, "future_sample_utime");
-  EXPECT_EQ(d.detail, "6000 > awaited 5000");
+  EXPECT_TRUE(d.timed);
+  d = gate.Check(Command(6000, 2), true);
+  EXPECT_EQ(d.reason, "command_future_sample");
   EXPECT_FALSE(gate.answered());
 
-  d = gate.Check(kForce, 5000, 3);
+  d = gate.Check(Command(5000, 3), true);
   EXPECT_EQ(d.action, Action::kAnswer);
   EXPECT_TRUE(gate.answered());
-  EXPECT_EQ(gate.answer_force_n(), kForce);
+  EXPECT_EQ(gate.answer().force_n, kForce);
 
-  d = gate.Check(2 * kForce, 5000, 4);
+  d = gate.Check(Command(5000, 4, 2 * kForce), true);
   EXPECT_EQ(d.action, Action::kReject);
   EXPECT_EQ(d.reason, "duplicate_answer");
   EXPECT_EQ(d.detail, "sample_utime 5000");
-  EXPECT_EQ(gate.answer_force_n(), kForce);
+  EXPECT_EQ(gate.answer().force_n, kForce);
   // Lockstep answers are not real-time applications.
   EXPECT_EQ(gate.last_applied_sample_utime(), -1);
 
   gate.OnSamplePublished(6000);  // the next tick awaits a new answer
   EXPECT_FALSE(gate.answered());
+}
+
+// A command the trust rules reject is never the answer: the awaited sample
+// stays unanswered, and the real answer that follows still counts.
+TEST(CommandGate, LockstepARejectedCommandIsNotTheAnswer) {
+  CommandGate gate = TrustingGate(true, 7000);
+  ForceCommand forged = Command(7000, 10, Vector6d::Constant(1e300));
+  forged.session_id = kSession + 1;  // another stack, a replayed log
+  EXPECT_EQ(gate.Check(forged, true).reason, "command_wrong_session");
+  EXPECT_EQ(gate.Check(Command(7000, 11, Vector6d::Constant(1e300)), false).reason,
+            "command_unauthentic");
+  EXPECT_FALSE(gate.answered());
+  ASSERT_EQ(gate.Check(Command(7000, 12), true).action, Action::kAnswer);
+  EXPECT_EQ(gate.answer().force_n, kForce);
+  EXPECT_EQ(gate.answer().seq, 12);
+  // A replay of that very answer (same seq) is not a second one either.
+  EXPECT_EQ(gate.Check(Command(7000, 12), true).reason, "command_seq_not_increasing");
 }
 
 TEST(LoopLatencyTracker, TimesTheFirstCommandOfEachNewerSample) {

@@ -19,6 +19,7 @@
 #include "stewart/sensor_t.hpp"
 #include "stewart/state_t.hpp"
 #include "stewart/test_support/child_process.h"
+#include "stewart/test_support/fake_safety_session.h"
 
 namespace stewart {
 namespace {
@@ -32,7 +33,10 @@ class Stack {
  public:
   /// hold_only: answer with the model's holding force alone (no feedback).
   Stack(const std::string& url, bool answer, bool hold_only = false)
-      : lcm_(MakeLcm(url)), answer_(answer), hold_only_(hold_only) {
+      : lcm_(MakeLcm(url)),
+        safety_(lcm_.get(), Config().lcm.channels.supervisor, Config().lcm.channels.command_safe),
+        answer_(answer),
+        hold_only_(hold_only) {
     const auto& ch = Config().lcm.channels;
     lcm_->subscribe(ch.sensors, &Stack::OnSensor, this)->setQueueCapacity(10000);
     lcm_->subscribe(ch.state_truth, &Stack::OnTruth, this)->setQueueCapacity(10000);
@@ -54,10 +58,9 @@ class Stack {
   void PublishCommand(int64_t sample_utime, const Vector6d& f) {
     force_command_t cmd{};
     cmd.utime = sample_utime;
-    cmd.seq = cmd_seq_++;
     cmd.sample_utime = sample_utime;
     for (int i = 0; i < 6; ++i) cmd.force_n[i] = f(i);
-    lcm_->publish(Config().lcm.channels.command_safe, &cmd);
+    safety_.Publish(cmd);
   }
 
   std::vector<sensor_t> sensors;
@@ -89,9 +92,9 @@ class Stack {
   }
 
   std::unique_ptr<lcm::LCM> lcm_;
+  test::FakeSafetySession safety_;
   bool answer_;
   bool hold_only_;
-  int64_t cmd_seq_ = 0;
 };
 
 TEST(PlantSimProcess, RealTimePublishesAndReactsToCommands) {
@@ -111,10 +114,13 @@ TEST(PlantSimProcess, RealTimePublishesAndReactsToCommands) {
   EXPECT_EQ(stack.health.back().state,
             static_cast<int8_t>(health_t::STATE_DEGRADED));  // says the fallback is on
 
-  // Push up for 0.3 s: holding force + 3 N per leg, answered every 2 ms.
+  // Push up for 0.3 s: holding force + 0.06 N per leg, answered every 2 ms.
+  // Against the legs' friction (2 N s/m) they rise at up to 30 mm/s, under
+  // plant_sim's guard (guard.leg_speed_cap_mps; a harder push trips it:
+  // plant_sim_trust_test).
   const auto end = Clock::now() + std::chrono::milliseconds(300);
   while (Clock::now() < end) {
-    stack.PublishCommand(stack.sensors.back().utime, stack.hold_n_ + Vector6d::Constant(3.0));
+    stack.PublishCommand(stack.sensors.back().utime, stack.hold_n_ + Vector6d::Constant(0.06));
     stack.Spin(0.002);
   }
   EXPECT_GT(stack.truth.back().q[2], z_locked + 2e-3);
@@ -175,6 +181,13 @@ double SinkAfter(int port, const std::string& truth_path, double duration_s) {
     args.push_back("--truth");
     args.push_back(truth_path);
   }
+  // The platform falls freely here, at metres per second squared: plant_sim's
+  // guard would stop it within a few centimetres per second (as it should);
+  // this test measures the physics, so its cap is out of the way.
+  const std::string overlay = testing::TempDir() + "/no_speed_guard.yaml";
+  std::ofstream(overlay) << "guard: {leg_speed_cap_mps: 100.0}\n";
+  args.push_back("--overlay");
+  args.push_back(overlay);
   test::ChildProcess sim(args);
   EXPECT_TRUE(sim.running());
   stack.SpinUntilExit(&sim, 15.0);

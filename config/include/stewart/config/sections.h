@@ -6,6 +6,7 @@
 #include "stewart/config/config_node.h"
 #include "stewart/controller/controller_config.h"
 #include "stewart/estimator/estimator_config.h"
+#include "stewart/guard/guard_config.h"
 #include "stewart/hw_bridge/hw_bridge_config.h"
 #include "stewart/model/actuator_params.h"
 #include "stewart/model/platform_params.h"
@@ -27,5 +28,7 @@ PlantSimConfig ParsePlantSimConfig(const ConfigNode& plant_sim);
 /// `actuators` decides the drive map's source: actuators.motor for a DC motor.
 HwBridgeConfig ParseHwBridgeConfig(const ConfigNode& hw_bridge, const ActuatorConfig& actuators);
 LcmConfig ParseLcmConfig(const ConfigNode& lcm, const ConfigNode& rates);
+/// `guard`: what the actuators accept and where they stop on their own.
+GuardConfig ParseGuardConfig(const ConfigNode& guard);
 
 }  // namespace stewart

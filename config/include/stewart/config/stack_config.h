@@ -5,6 +5,7 @@
 
 #include "stewart/controller/controller_config.h"
 #include "stewart/estimator/estimator_config.h"
+#include "stewart/guard/guard_config.h"
 #include "stewart/hw_bridge/hw_bridge_config.h"
 #include "stewart/model/actuator_params.h"
 #include "stewart/model/dc_motor.h"
@@ -28,6 +29,7 @@ struct StackConfig {
   EstimatorConfig estimator;
   PlantSimConfig plant_sim;
   HwBridgeConfig hw_bridge;
+  GuardConfig guard;
   LcmConfig lcm;
   std::string source_path;  ///< file it was loaded from, "" for strings
 };

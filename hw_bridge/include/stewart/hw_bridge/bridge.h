@@ -4,11 +4,20 @@
 // with the command watchdog and the link statistics, and what the node
 // reports about the link. BridgeNode (hw_bridge/node) wires it to LCM and a
 // Transport.
+//
+// In normal operation only the announced safety session's commands move the
+// legs (SafeCommandAcceptor, guard/), and the bridge's own last-line guard
+// on its own pot readings (ActuatorGuard) turns the drive off, latched until
+// an operator RESET (docs/operations.md, "Trust model").
 #include <cstddef>
 #include <cstdint>
 #include <string>
 
 #include "stewart/common/enum_table.h"
+#include "stewart/common/signals.h"
+#include "stewart/guard/actuator_guard.h"
+#include "stewart/guard/guard_config.h"
+#include "stewart/guard/safe_command_acceptor.h"
 #include "stewart/hw_bridge/bringup.h"
 #include "stewart/hw_bridge/calibration.h"
 #include "stewart/hw_bridge/drive_map.h"
@@ -33,16 +42,20 @@ struct SensorSample {
 /// (bringup.h) "command" is the latest duty command, else the latest safe
 /// force command.
 enum class DriveReason {
-  kCommand,  ///< the latest command, mapped
-  kMissing,  ///< no valid command received yet: zero drive
-  kStale,    ///< the held command is older than command_timeout_s: zero drive
-  kInvalid,  ///< the latest command was non-finite: zero drive
+  kCommand,   ///< the latest command, mapped
+  kMissing,   ///< no valid command received yet: zero drive
+  kStale,     ///< the held command is older than command_timeout_s: zero drive
+  kInvalid,   ///< the latest command was non-finite: zero drive
+  kDriveOff,  ///< the latest safe command says FLAG_DRIVE_OFF: zero drive
+  kGuard,     ///< the last-line guard has tripped (latched): zero drive
 };
-inline constexpr EnumTable<DriveReason, 4> kDriveReasonNames{{{
+inline constexpr EnumTable<DriveReason, 6> kDriveReasonNames{{{
     {DriveReason::kCommand, "command"},
     {DriveReason::kMissing, "missing"},
     {DriveReason::kStale, "stale"},
     {DriveReason::kInvalid, "invalid"},
+    {DriveReason::kDriveOff, "drive_off"},
+    {DriveReason::kGuard, "guard"},
 }}};
 inline const char* ToString(DriveReason reason) { return kDriveReasonNames.Name(reason).data(); }
 
@@ -53,13 +66,15 @@ enum class CommandVerdict {
   kFuture,      ///< newer than the newest sample by more than the timeout:
                 ///< another time base (a second stack?), ignored
   kWrongMode,   ///< a force command in bring-up mode, a duty command outside it: ignored
+  kUntrusted,   ///< the acceptor refused it (HwBridge::last_rejection() says why): ignored
 };
-inline constexpr EnumTable<CommandVerdict, 5> kCommandVerdictNames{{{
+inline constexpr EnumTable<CommandVerdict, 6> kCommandVerdictNames{{{
     {CommandVerdict::kAccepted, "accepted"},
     {CommandVerdict::kNonFinite, "non_finite_command"},
     {CommandVerdict::kOutOfOrder, "out_of_order_command"},
     {CommandVerdict::kFuture, "future_command"},
     {CommandVerdict::kWrongMode, "wrong_mode_command"},
+    {CommandVerdict::kUntrusted, "untrusted_command"},
 }}};
 inline const char* ToString(CommandVerdict verdict) {
   return kCommandVerdictNames.Name(verdict).data();
@@ -100,6 +115,9 @@ struct BridgeCounters {
   uint64_t force_deadzoned =
       0;                     ///< legs whose non-zero force fell in the dead zone (frames x legs)
   uint64_t guard_trips = 0;  ///< bring-up: legs the guard tripped (events)
+  uint64_t drive_off_frames = 0;   ///< frames sent with zero drive for the supervisor's drive off
+  uint64_t guard_frames = 0;       ///< frames sent with zero drive for the tripped last-line guard
+  int64_t applied_age_max_us = 0;  ///< oldest command whose force went out (sample age, us)
   uint64_t guard_limited_frames = 0;  ///< bring-up: frames in which the guard zeroed a leg's duty
   uint64_t device_rx_corrupt = 0;     ///< the device's own counters (latest)
   uint64_t device_rx_lost = 0;
@@ -109,9 +127,10 @@ struct BridgeCounters {
 
 class HwBridge {
  public:
-  /// `bringup`: hw_bridge --bringup (bringup.h); off by default.
+  /// `bringup`: hw_bridge --bringup (bringup.h); off by default. `guard`:
+  /// the config's `guard:` section (sessions, the last-line guard's limits).
   HwBridge(const HwBridgeConfig& hw, double min_length_m, double stroke_m, double force_limit_n,
-           const BringupOptions& bringup = {});
+           const BringupOptions& bringup = {}, const GuardConfig& guard = {});
 
   /// A decoded sensor frame that arrived at host_rx_us. Returns false (and
   /// counts) when it must not be published: duplicate or reordered.
@@ -119,8 +138,21 @@ class HwBridge {
   /// Any decoded frame from the device; *sample is set for kPublish.
   FrameOutcome OnFrame(const DecodedFrame& frame, int64_t host_rx_us, SensorSample* sample);
 
-  /// A safe command (force_command_t.utime, force_n). kWrongMode in bring-up.
-  CommandVerdict OnForceCommand(int64_t utime, const Vector6d& force_n);
+  /// A session announcement (supervisor_state_t); `authentic`: its MAC
+  /// verified; `wall_us`: the host's monotonic clock.
+  AnnouncementVerdict OnAnnouncement(const SessionAnnouncement& a, bool authentic,
+                                     int64_t wall_us) {
+    return acceptor_.OnAnnouncement(a, authentic, wall_us);
+  }
+  /// A safe command (force_command_t); `authentic`: its MAC verified (true
+  /// without a key). kWrongMode in bring-up; kUntrusted when the acceptor
+  /// refuses it (last_rejection()). An accepted command beyond the guard's
+  /// force bound trips the guard: accepted, and zero drive.
+  CommandVerdict OnSafeCommand(const ForceCommand& command, bool authentic);
+  CommandRejection last_rejection() const { return last_rejection_; }
+  /// The operator's RESET (its MAC and freshness checked by the caller):
+  /// clears the tripped guard iff the readings are back inside.
+  GuardResetResult OnOperatorReset();
   /// Bring-up only (kWrongMode otherwise): a duty per leg (duty_command_t:
   /// utime = the sample it answers, duty positive extends), with the same
   /// checks of time and finiteness as a force command.
@@ -146,6 +178,9 @@ class HwBridge {
   const AppliedDuty& applied() const { return applied_; }
   /// Bring-up: the guard on the bridge's readings.
   const LegGuard& guard() const { return guard_; }
+  /// Normal operation: the last-line guard on the bridge's readings.
+  const ActuatorGuard& actuator_guard() const { return actuator_guard_; }
+  const SafeCommandAcceptor& acceptor() const { return acceptor_; }
   uint16_t last_device_status() const { return last_device_status_; }
   const BridgeCounters& counters() const { return counters_; }
   void ResetWindows() {
@@ -155,6 +190,8 @@ class HwBridge {
 
  private:
   DriveReason CurrentReason() const;
+  /// Bit i: leg i's reading is in its calibrated span and not flagged.
+  uint8_t PlausibleMask(const SensorFrame& frame) const;
   CommandVerdict AcceptCommand(int64_t utime, bool finite);
   void UpdateBringup(const SensorFrame& frame, const SensorSample& sample);
 
@@ -173,6 +210,11 @@ class HwBridge {
   uint16_t last_device_status_ = 0;
   bool tick_frame_due_ = false;
   bool sent_since_sample_ = false;
+
+  SafeCommandAcceptor acceptor_;
+  ActuatorGuard actuator_guard_;
+  CommandRejection last_rejection_ = CommandRejection::kNone;
+  bool command_drive_off_ = false;
 
   bool have_command_ = false;
   bool command_invalid_ = false;

@@ -17,10 +17,13 @@
 //   - reading: a non-finite or implausible reading trips the leg.
 // A tripped leg gets zero duty until it is re-armed by a zero duty command
 // for it (Apply) with a plausible reading; the first reason is kept.
+// In normal operation the bridge's last-line guard (guard/actuator_guard.h)
+// watches the legs instead, with the same speed estimate.
 #include <array>
 #include <cstdint>
 
 #include "stewart/common/enum_table.h"
+#include "stewart/guard/leg_speed_estimator.h"
 #include "stewart/model/types.h"
 
 namespace stewart::hw {
@@ -48,29 +51,6 @@ inline constexpr EnumTable<GuardReason, 5> kGuardReasonNames{{{
     {GuardReason::kReading, "bad_reading"},
 }}};
 inline const char* ToString(GuardReason reason) { return kGuardReasonNames.Name(reason).data(); }
-
-/// Leg speed from the last kWindow readings by a least-squares slope (a
-/// 25 ms window at 1 kHz: the pot's quantisation, 0.2 mm on the simulated
-/// 10-bit ADC, gives ~3 mm/s of noise on it, against 0.2 m/s on a one-sample
-/// difference, at 12 ms of delay). Fixed size, no allocation.
-class LegSpeedEstimator {
- public:
-  static constexpr int kWindow = 25;
-  /// Readings further apart than this restart the window.
-  static constexpr int64_t kMaxGapUs = 100'000;
-
-  void Add(int64_t utime, double length_m);
-  /// 0 until the window is full (after a start or a gap).
-  double speed_mps() const { return speed_mps_; }
-  void Reset() { count_ = 0, speed_mps_ = 0.0; }
-
- private:
-  std::array<int64_t, kWindow> utime_{};
-  std::array<double, kWindow> length_m_{};
-  int next_ = 0;
-  int count_ = 0;
-  double speed_mps_ = 0.0;
-};
 
 class LegGuard {
  public:

@@ -1,6 +1,6 @@
 #pragma once
 // Which force acts on the plant in each mode (docs/simulation.md, "Modes"),
-// free of LCM so it is unit-testable. Times are stack times in seconds.
+// free of LCM so it is unit-testable. Times are stack times in microseconds.
 #include <cstdint>
 #include <string>
 
@@ -8,38 +8,41 @@
 
 namespace stewart {
 
-enum class TimeoutFallback {
-  kActuatorsOff,  ///< "off": zero force; the P-16P lead screws hold the leg lengths
-  kHoldLast,      ///< "hold_last": keep applying the last command
-};
-
-/// "off" | "hold_last"; throws std::invalid_argument.
-TimeoutFallback ParseTimeoutFallback(const std::string& name);
-
 /// Why a received force command cannot be applied; "" when it can.
-/// Checks finiteness only: the magnitude is the actuator's to saturate.
+/// Checks finiteness only: the magnitude is the actuator's to saturate (and
+/// the guard's to bound, guard/actuator_guard.h).
 std::string ForceCommandProblem(const Vector6d& force_n);
 
-/// Real-time mode: holds the newest valid command; once none arrived for
-/// longer than the timeout (or none ever arrived) applies the fallback.
+/// Real-time mode: holds the newest accepted command while its sample is no
+/// older than max_age against the sample of the tick at hand; after that (or
+/// before the first command) the actuators are off and the lead screws hold
+/// the legs. The age is stack time, the command's own sample against the
+/// plant's newest, not when the command arrived: a command computed from an
+/// old sample (a stack that fell behind, an estimator stopped for 0.5 s) is
+/// never applied, however recently it came in.
 class RealTimeCommandHold {
  public:
-  RealTimeCommandHold(double command_timeout_s, TimeoutFallback fallback);
+  /// max_age_us > 0 (checked).
+  explicit RealTimeCommandHold(int64_t max_age_us);
 
-  void OnCommand(const Vector6d& force_n, double now_s);
+  /// An accepted command; `drive_off`: FLAG_DRIVE_OFF, actuators off while
+  /// it is the newest.
+  void OnCommand(const Vector6d& force_n, int64_t sample_utime, bool drive_off);
 
   struct Decision {
     Vector6d force_cmd_n = Vector6d::Zero();
     bool actuators_off = false;
-    bool timed_out = false;  ///< the fallback is in force
+    bool timed_out = false;  ///< no command young enough: actuators off
+    int64_t age_us = -1;     ///< age of the command applied (-1: none applied)
   };
-  Decision Decide(double now_s) const;
+  /// For the tick whose sample is `tick_sample_utime`.
+  Decision Decide(int64_t tick_sample_utime) const;
 
  private:
-  double timeout_s_;
-  TimeoutFallback fallback_;
+  int64_t max_age_us_;
   bool have_command_ = false;
-  double last_command_s_ = 0.0;
+  int64_t sample_utime_ = 0;
+  bool drive_off_ = false;
   Vector6d last_force_n_ = Vector6d::Zero();
 };
 

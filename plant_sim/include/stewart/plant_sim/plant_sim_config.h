@@ -11,8 +11,9 @@ struct PlantSimConfig {
   std::string integrator = "arkode_erk";
   double rel_tol = 1e-8;
   double abs_tol = 1e-10;
+  /// A safe command whose sample is older than this (stack time, against
+  /// the newest published sample) is never applied (s).
   double command_timeout_s = 0.05;
-  std::string timeout_fallback = "off";  ///< off (zero force, legs locked) | hold_last
   double lockstep_timeout_s = 5.0;
   Vector6d initial_pose = Vector6d::Zero();
   Vector6d initial_velocity = Vector6d::Zero();
