@@ -150,8 +150,10 @@ void PlantSimNode::HandleCommand(const lcm::ReceiveBuffer*, const std::string&,
       health_.Reject(d.reason, d.detail);
       return;
     case CommandGate::Action::kAnswer:
+      answer_drive_off_ = (msg->flags & force_command_t::FLAG_DRIVE_OFF) != 0;
       return;
     case CommandGate::Action::kApply:
+      drive_off_ = (msg->flags & force_command_t::FLAG_DRIVE_OFF) != 0;
       hold_.OnCommand(force_n, plant_.time_s());
       return;
   }
@@ -178,8 +180,10 @@ void PlantSimNode::UpdateTickCounters() {
 
 void PlantSimNode::ApplyRealTimeDecision() {
   const RealTimeCommandHold::Decision d = hold_.Decide(plant_.time_s());
-  plant_.SetActuatorsOff(d.actuators_off);
-  if (!d.actuators_off) plant_.SetForceCommand(d.force_cmd_n);
+  // Drive off: the lead screws hold the legs (DISARMED, ESTOP).
+  const bool off = d.actuators_off || (drive_off_ && !d.timed_out);
+  plant_.SetActuatorsOff(off);
+  if (!off) plant_.SetForceCommand(d.force_cmd_n);
   if (d.timed_out != fallback_active_) {
     fallback_active_ = d.timed_out;
     if (d.timed_out) {
@@ -263,7 +267,8 @@ ExitCode PlantSimNode::RunLockstep() {
       receiver_.HandleTimeout(step.wait_ms);
       health_.MaybePublish(lcm_);
     }
-    plant_.SetForceCommand(gate_.answer_force_n());
+    plant_.SetActuatorsOff(answer_drive_off_);
+    if (!answer_drive_off_) plant_.SetForceCommand(gate_.answer_force_n());
     AdvanceTick();
   }
   return ExitCode::kOk;

@@ -71,6 +71,10 @@ class PlantSimNode {
   int64_t tick_ = 0;        // index of the newest published sample
   int64_t tick_utime_ = 0;  // its utime
   bool fallback_active_ = false;
+  // FLAG_DRIVE_OFF of the latest applied (real time) and of the awaited
+  // (lockstep) command: the supervisor is DISARMED or in ESTOP.
+  bool drive_off_ = true;
+  bool answer_drive_off_ = true;
   sensor_t last_sensor_{};
   CommandGate gate_;
   LoopLatencyTracker latency_tracker_;

@@ -13,6 +13,7 @@
 #include "stewart/node/lcm_config.h"
 #include "stewart/plant_sim/plant_sim_config.h"
 #include "stewart/safety/safety_config.h"
+#include "stewart/safety/supervisor.h"
 
 namespace stewart {
 
@@ -27,5 +28,6 @@ PlantSimConfig ParsePlantSimConfig(const ConfigNode& plant_sim);
 /// `actuators` decides the drive map's source: actuators.motor for a DC motor.
 HwBridgeConfig ParseHwBridgeConfig(const ConfigNode& hw_bridge, const ActuatorConfig& actuators);
 LcmConfig ParseLcmConfig(const ConfigNode& lcm, const ConfigNode& rates);
+safety::SupervisorConfig ParseSupervisorConfig(const ConfigNode& supervisor);
 
 }  // namespace stewart
