@@ -129,14 +129,24 @@ mkdir -p "$OUT"
 # the config.yaml there is the merged config every process loads (each gets
 # the file and the overlays: a plant's truth overrides the file, not what
 # the overlays make the stack believe), so replay and the report read what ran.
-OVERLAY_ARGS=()
+# Supervision and trust (docs/operations.md): a key per run folder for the
+# authenticated channels (CMD_SAFE, SUPERVISOR, OPERATOR), and in simulation
+# (plant_sim or the device emulator) a supervisor that arms by itself. On a
+# real device the stack starts DISARMED: an operator arms it. This overlay
+# comes first, so the user's overlays can override it.
+(umask 077 && od -An -tx1 -N32 /dev/urandom | tr -d ' \n' >"$OUT/auth.key")
+SIMULATED=$([[ $PLANT == sim || $EMULATOR == 1 ]] && echo true || echo false)
+{
+  echo "# written by tools/launch.sh"
+  echo "lcm:"
+  echo "  auth_key_file: \"$OUT/auth.key\""
+  echo "supervisor:"
+  echo "  auto_arm: $SIMULATED"
+} >"$OUT/launch-overlay.yaml"
+OVERLAY_ARGS=(--overlay "$OUT/launch-overlay.yaml")
 for f in "${OVERLAYS[@]}"; do OVERLAY_ARGS+=(--overlay "$f"); done
-if ((${#OVERLAYS[@]})); then
-  "$(bin stewart_config_merge)" --config "$CONFIG" "${OVERLAY_ARGS[@]}" --out "$OUT/config.yaml" ||
-    { echo "launch: the overlays do not apply to $CONFIG" >&2; exit 2; }
-else
-  cp "$CONFIG" "$OUT/config.yaml"
-fi
+"$(bin stewart_config_merge)" --config "$CONFIG" "${OVERLAY_ARGS[@]}" --out "$OUT/config.yaml" ||
+  { echo "launch: the overlays do not apply to $CONFIG" >&2; exit 2; }
 [[ -n $DURATION ]] || DURATION=$("$CONTROLLER" --config "$CONFIG" "${OVERLAY_ARGS[@]}" --scenario "$SCENARIO" --print-duration)
 [[ -n $LOG ]] || LOG="$OUT/log.lcm"
 if [[ -z $URL ]]; then
@@ -155,6 +165,7 @@ else cp "$ROOT/config/scenarios/$SCENARIO.yaml" "$OUT/scenario.yaml"; fi
   echo "scenario: $SCENARIO"
   echo "duration_s: $DURATION"
   echo "variant: ${VARIANT:-from config}"
+  echo "launch_overlay: $OUT/launch-overlay.yaml"
   ((${#OVERLAYS[@]})) && echo "overlays: [$(IFS=,; echo "${OVERLAYS[*]}" | sed 's/,/, /g')]"
   echo "rt_priority: $RT_PRIORITY"
   echo "loop_cpu: $LOOP_CPU"
@@ -168,6 +179,11 @@ echo "   LCM URL:    $URL"
 ((RT_PRIORITY > 0)) && echo "   scheduling: SCHED_FIFO $RT_PRIORITY for the loop's processes"
 [[ $LOOP_CPU != none ]] && echo "   loop CPU:   $LOOP_CPU (plant, estimator, controller, safety)"
 echo "   process logs: $OUT/<process>.log"
+if [[ $SIMULATED == true ]]; then
+  echo "   supervisor: arms automatically (simulation; supervisor.auto_arm)"
+else
+  echo "   supervisor: DISARMED until you arm: $(bin stewart_ctl) arm --config $OUT/config.yaml --lcm-url '$URL'"
+fi
 
 PIDS=() NAMES=()
 start() { # name, command...

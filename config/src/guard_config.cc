@@ -10,10 +10,8 @@ GuardConfig ParseGuardConfig(const ConfigNode& guard) {
   g.session_max_age_s = guard.PositiveDouble("session_max_age_s");
   g.session_silence_s = guard.PositiveDouble("session_silence_s");
   g.session_silence_wall_s = guard.PositiveDouble("session_silence_wall_s");
-  g.operator_max_age_s = guard.PositiveDouble("operator_max_age_s");
   // Microsecond fields downstream: a limit below 1 us would round to 0.
-  for (const char* key :
-       {"session_max_age_s", "session_silence_s", "session_silence_wall_s", "operator_max_age_s"}) {
+  for (const char* key : {"session_max_age_s", "session_silence_s", "session_silence_wall_s"}) {
     if (guard.PositiveDouble(key) < 1e-3) guard.Fail(key, "must be at least 0.001 s");
   }
   // A session is renewed at least every 100 ms of stack time (the safety

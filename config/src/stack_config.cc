@@ -49,6 +49,7 @@ StackConfig ParseRoot(const YAML::Node& yaml, const std::string& source) {
   c.sensors = ParseSensorConfig(root.Child("sensors"));
   c.controller = ParseControllerConfig(root.Child("controller"));
   c.safety = ParseSafetyConfig(root.Child("safety"));
+  c.supervisor = ParseSupervisorConfig(root.Child("supervisor"));
   c.estimator = ParseEstimatorConfig(root.Child("estimator"));
   c.plant_sim = ParsePlantSimConfig(root.Child("plant_sim"));
   c.hw_bridge = ParseHwBridgeConfig(root.Child("hw_bridge"), c.actuators);

@@ -65,7 +65,8 @@ const std::set<std::string> kDisturbanceKeys = {
     "constant_force_n", "constant_torque_nm", "steps", "pulses", "sinusoids", "random_pushes"};
 // A whole stack config works as a truth: its other sections are not physics.
 const std::set<std::string> kIgnoredSections = {"controller", "safety", "estimator", "plant_sim",
-                                                "hw_bridge",  "rates",  "lcm",       "guard"};
+                                                "hw_bridge",  "rates",  "lcm",       "supervisor",
+                                                "guard"};
 
 void CheckKeys(const YAML::Node& node, const std::string& path, const std::set<std::string>& keys) {
   if (!node.IsMap()) throw ConfigError(path, "expected a mapping");

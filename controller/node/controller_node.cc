@@ -24,14 +24,18 @@ Setpoint FromMessage(const setpoint_t& msg) {
 }  // namespace
 
 ControllerNode::ControllerNode(const StackConfig& config, lcm::LCM* lcm,
-                               std::optional<Scenario> scenario, bool exit_at_end)
+                               std::optional<Scenario> scenario, bool exit_at_end,
+                               bool restart_scenario)
     : config_(config),
       lcm_(lcm),
       receiver_(config.lcm.url),
       health_("controller", config.lcm.channels.health, config.lcm.health_rate_hz),
       process_(config.platform, config.controller, config.home_pose, std::move(scenario), &health_),
+      auth_(MessageAuthenticator::FromKeyFile(config.lcm.auth_key_file)),
       exit_at_end_(exit_at_end) {
+  if (restart_scenario) process_.RestartScenario();
   receiver_.Subscribe(config_.lcm.channels.state_estimate, &ControllerNode::OnState, this);
+  receiver_.Subscribe(config_.lcm.channels.supervisor, &ControllerNode::OnSupervisor, this);
   // A scenario's setpoints are echoed on the setpoint channel: listening to
   // it as well would feed the controller its own output.
   if (!process_.controller().following_scenario()) {
@@ -42,6 +46,17 @@ ControllerNode::ControllerNode(const StackConfig& config, lcm::LCM* lcm,
 void ControllerNode::OnSetpoint(const lcm::ReceiveBuffer*, const std::string&,
                                 const setpoint_t* msg) {
   process_.OnSetpoint(FromMessage(*msg));
+}
+
+void ControllerNode::OnSupervisor(const lcm::ReceiveBuffer*, const std::string&,
+                                  const supervisor_state_t* msg) {
+  if (!auth_.Verify(*msg)) {
+    health_.Reject("supervisor_bad_mac");
+    return;
+  }
+  const bool running = msg->state == supervisor_state_t::STATE_ARMING ||
+                       msg->state == supervisor_state_t::STATE_ARMED;
+  process_.OnSupervisor(msg->utime, msg->motion_time_us, running);
 }
 
 void ControllerNode::OnState(const lcm::ReceiveBuffer*, const std::string&, const state_t* msg) {

@@ -12,6 +12,7 @@ int main(int argc, char** argv) {
   std::string scenario_name;
   bool exit_at_end = false;
   bool print_duration = false;
+  bool restart_scenario = false;
   std::optional<stewart::Scenario> scenario;
   return stewart::NodeMain(
       argc, argv, {"controller", "Stewart platform nominal controller: state estimate -> F_des"},
@@ -20,6 +21,9 @@ int main(int argc, char** argv) {
                        "scenario name (config/scenarios/<name>.yaml) or path; "
                        "without one, setpoints come live from the setpoint channel");
         app.add_flag("--exit-at-end", exit_at_end, "exit once the scenario's duration has elapsed");
+        app.add_flag("--restart-scenario", restart_scenario,
+                     "start the scenario over at t = 0 (default: continue at the supervisor's "
+                     "motion clock, so a restarted controller takes up where the motion was)");
         app.add_flag("--print-duration", print_duration,
                      "print the scenario's duration in seconds and exit");
       },
@@ -41,7 +45,8 @@ int main(int argc, char** argv) {
         return std::nullopt;
       },
       [&](const stewart::StackConfig& config, lcm::LCM* lcm) {
-        stewart::ControllerNode node(config, lcm, std::move(scenario), exit_at_end);
+        stewart::ControllerNode node(config, lcm, std::move(scenario), exit_at_end,
+                                     restart_scenario);
         return node.Run();
       });
 }

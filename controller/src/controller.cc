@@ -1,5 +1,7 @@
 #include "stewart/controller/controller.h"
 
+#include <algorithm>
+
 #include "stewart/model/kinematics.h"
 
 namespace stewart {
@@ -25,6 +27,11 @@ SetpointStatus Controller::OfferSetpoint(const Setpoint& setpoint) {
   return status;
 }
 
+void Controller::SetMotionClock(int64_t utime, int64_t motion_time_us, bool running) {
+  if (!motion_clock_ && restart_at_first_clock_) motion_offset_us_ = motion_time_us;
+  motion_clock_ = MotionClock{utime, motion_time_us, running};
+}
+
 StepStatus Controller::Step(int64_t utime, const Vector6d& q, const Vector6d& qd,
                             ControllerOutput* out) {
   return Step(utime, q, qd, Vector6d::Zero(), out);
@@ -38,7 +45,13 @@ StepStatus Controller::Step(int64_t utime, const Vector6d& q, const Vector6d& qd
   if (last_utime_ && utime <= *last_utime_) return StepStatus::kTimeNotIncreasing;
   last_utime_ = utime;
   if (!first_utime_) first_utime_ = utime;
-  const double t_s = 1e-6 * static_cast<double>(utime - *first_utime_);
+  double t_s = 1e-6 * static_cast<double>(utime - *first_utime_);
+  if (motion_clock_) {
+    const MotionClock& m = *motion_clock_;
+    const int64_t since_us = m.running ? std::max<int64_t>(utime - m.utime, 0) : 0;
+    t_s = 1e-6 * static_cast<double>(
+                     std::max<int64_t>(m.motion_time_us + since_us - motion_offset_us_, 0));
+  }
 
   std::optional<SetpointStatus> scenario_rejection;
   if (scenario_) {

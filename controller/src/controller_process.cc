@@ -20,6 +20,11 @@ void ControllerProcess::OnSetpoint(const Setpoint& setpoint) {
   if (status != SetpointStatus::kAccepted) counters_->Reject(ToString(status));
 }
 
+void ControllerProcess::OnSupervisor(int64_t utime, int64_t motion_time_us, bool running) {
+  counters_->CountIn();
+  controller_.SetMotionClock(utime, motion_time_us, running);
+}
+
 ControllerVerdict ControllerProcess::OnState(const StateSample& state,
                                              ControllerProcessOutput* out) {
   counters_->CountIn();

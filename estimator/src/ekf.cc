@@ -16,8 +16,12 @@ constexpr double kUsToS = 1e-6;
 constexpr double kMaxPositionStdM = 0.05;
 
 double HoldTimeConstant(const ActuatorConfig& actuators) {
-  if (actuators.kind != ActuatorKind::kDcMotor) return 0.0;  // never used
-  return std::max(actuators.motor.reflected_mass_kg / ModelLegDampingNspm(actuators), 2e-3);
+  // Ideal-force legs are held only when the supervisor turns the drive off:
+  // the lead screws stop them within a few samples.
+  constexpr double kMinHoldTimeConstantS = 2e-3;
+  if (actuators.kind != ActuatorKind::kDcMotor) return kMinHoldTimeConstantS;
+  return std::max(actuators.motor.reflected_mass_kg / ModelLegDampingNspm(actuators),
+                  kMinHoldTimeConstantS);
 }
 
 // Discrete white-noise acceleration (one sample of constant acceleration with
@@ -141,11 +145,12 @@ Ekf::Ekf(const PlatformParams& params, const ActuatorConfig& actuators, const Se
       std::max(sensors.orientation_noise_std_rad * sensors.orientation_noise_std_rad, 1e-14);
 }
 
-void Ekf::SetForceCommand(int64_t utime, const Vector6d& force_n) {
+void Ekf::SetForceCommand(int64_t utime, const Vector6d& force_n, bool drive_off) {
   if (!force_n.allFinite()) return;  // the node counts it; never feed NaN into the model
   TimedCommand& slot = command_history_[static_cast<size_t>(command_next_)];
   slot.utime = utime;
   slot.force_n = force_n.cwiseMax(-actuators_.force_limit_n).cwiseMin(actuators_.force_limit_n);
+  slot.drive_off = drive_off;
   command_next_ = (command_next_ + 1) % kCommandHistory;
   command_count_ = std::min(command_count_ + 1, kCommandHistory);
 }
@@ -252,8 +257,11 @@ void Ekf::Predict(double dt_s, int64_t utime, const EulerAngleTrig& trig, uint32
   // it would predict the platform sinking against the legs' damping and
   // explain the legs' stillness as model error d, which the controller and
   // the filter then apply as soon as the drive returns.
-  const bool legs_held = dynamics_model && actuators_.kind == ActuatorKind::kDcMotor &&
-                         (!command_fresh || command->force_n.isZero());
+  // Any legs with the drive turned off by the supervisor (DISARMED, ESTOP)
+  // are held likewise.
+  const bool legs_held = dynamics_model && ((command_fresh && command->drive_off) ||
+                                            (actuators_.kind == ActuatorKind::kDcMotor &&
+                                             (!command_fresh || command->force_n.isZero())));
   const bool use_dynamics = dynamics_model && command_fresh && !legs_held;
   double sigma_lin = config_.process_accel_std_mps2;
   double sigma_ang = config_.process_angaccel_std_radps2;

@@ -33,7 +33,8 @@ void EstimatorProcess::OnCommand(const ForceCommand& command) {
     counters_->Reject("command_non_finite");
     return;
   }
-  ekf_.SetForceCommand(command.sample_utime, command.force_n);
+  ekf_.SetForceCommand(command.sample_utime, command.force_n,
+                       (command.flags & kCommandDriveOff) != 0);
 }
 
 bool EstimatorProcess::OnSensor(const SensorSample& sample, StateSample* out) {

@@ -48,7 +48,7 @@ BridgeNode::BridgeNode(const StackConfig& config, lcm::LCM* lcm, hw::Transport* 
               config.platform.leg_max_length_m - config.platform.leg_min_length_m,
               config.actuators.force_limit_n, bringup, config.guard),
       auth_(MessageAuthenticator::FromKeyFile(config.lcm.auth_key_file)),
-      operator_check_(SecondsToMicros(config.guard.operator_max_age_s)),
+      operator_check_(SecondsToMicros(config.supervisor.operator_time_window_s)),
       health_("hw_bridge", config.lcm.channels.health, config.lcm.health_rate_hz),
       reader_(transport->datagram()) {
   receiver_.Subscribe(config.lcm.channels.supervisor, &BridgeNode::OnSupervisor, this);

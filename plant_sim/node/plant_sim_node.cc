@@ -56,7 +56,7 @@ PlantSimNode::PlantSimNode(const StackConfig& config, const PlantTruth& truth, l
       // own pots: a truth with other legs shows up as it would on the device.
       guard_(ActuatorGuardLimitsOf(config.guard, config.platform.leg_min_length_m,
                                    config.platform.leg_max_length_m)),
-      operator_check_(SecondsToMicros(config.guard.operator_max_age_s)),
+      operator_check_(SecondsToMicros(config.supervisor.operator_time_window_s)),
       period_us_(PeriodUs(config.sensors.rate_hz)),
       gate_(options.mode == SimMode::kLockstep,
             AcceptorLimitsOf(config.guard, config.plant_sim.command_timeout_s)),

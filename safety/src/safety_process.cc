@@ -14,15 +14,18 @@ bool StateFinite(const StateSample& s) {
 }  // namespace
 
 SafetyProcess::SafetyProcess(const PlatformParams& platform, const SafetyConfig& safety,
-                             const ActuatorConfig& actuators, ReferenceQpSolver* reference,
-                             HealthCounters* counters)
+                             const ActuatorConfig& actuators, const SupervisorConfig& supervisor,
+                             ReferenceQpSolver* reference, HealthCounters* counters)
     : filter_(platform, safety, actuators, reference),
+      supervisor_(supervisor),
       counters_(counters),
       stale_age_us_(static_cast<int64_t>(safety.stale_age_s * 1e6)) {
   STEWART_CHECK(counters_ != nullptr, "SafetyProcess needs its counters");
   counters_->SetCounter("fallback_commands", 0);
   counters_->SetCounter("active_steps", 0);
   counters_->SetCounter("infeasible", 0);
+  counters_->SetCounter("hold_commands", 0);
+  counters_->SetCounter("drive_off_commands", 0);
   counters_->SetState(health_state::kOk);
 }
 
@@ -132,7 +135,7 @@ SafetyOutput SafetyProcess::Filter(const StateSample& state, const ForceCommand&
       filter_.Step(state.q, state.qd, nominal.force_n, disturbance, &diagnostics_);
   if (diagnostics_.flags & kFlagInvalidInput) counters_->Reject("invalid_nominal");
   if (diagnostics_.flags & kFlagOutsideSafeSet) counters_->Count("outside_safe_set");
-  return Emit(f_safe, nominal.sample_utime, 0);
+  return Supervise(state, f_safe, nominal.sample_utime, 0);
 }
 
 SafetyOutput SafetyProcess::Fallback(const StateSample& state, int32_t reason) {
@@ -140,19 +143,64 @@ SafetyOutput SafetyProcess::Fallback(const StateSample& state, int32_t reason) {
       state.q, state.qd, GeneralizedDisturbance{state.disturbance, state.disturbance_std},
       &diagnostics_);
   counters_->Count("fallback_commands");
-  return Emit(f, state.sample_utime, reason);
+  return Supervise(state, f, state.sample_utime, reason);
 }
 
-SafetyOutput SafetyProcess::Emit(const Vector6d& force_n, int64_t sample_utime,
-                                 int32_t fallback_reason) {
+SafetyOutput SafetyProcess::Supervise(const StateSample& state, const Vector6d& force_n,
+                                      int64_t sample_utime, int32_t fallback_reason) {
+  const bool filtered = fallback_reason == 0;
+  SupervisorStep step;
+  step.utime = state.utime;
+  step.sample_utime = state.sample_utime;
+  step.state_usable = StateUsable(state);
+  step.inside_limits =
+      filtered && (diagnostics_.flags & (kFlagOutsideSafeSet | kFlagInvalidInput)) == 0;
+  step.filtered = filtered;
+  const SupervisorMode mode = supervisor_.OnStep(step);
+  // The heartbeat says when the platform is not under the filtered command.
+  counters_->SetState(filtered && !mode.drive_off() && mode.state != SupervisorState::kHold
+                          ? health_state::kOk
+                          : health_state::kDegraded);
+  if (mode.drive_off()) {
+    counters_->Count("drive_off_commands");
+    // Not a control law's output: flagged a fallback, as the safe stop is.
+    return Emit(Vector6d::Zero(), sample_utime,
+                kCommandDriveOff | kCommandFallback | fallback_reason, fallback_reason, mode);
+  }
+  if (!filtered) {
+    // Already the safe stop (a fallback): HOLD, or a fault ARMING/ARMED just
+    // turned into HOLD.
+    if (mode.state == SupervisorState::kHold) counters_->Count("hold_commands");
+    return Emit(force_n, sample_utime, diagnostics_.flags | fallback_reason, fallback_reason, mode);
+  }
+  if (mode.state == SupervisorState::kArmed) {
+    return Emit(force_n, sample_utime, diagnostics_.flags, 0, mode);
+  }
+  const GeneralizedDisturbance disturbance{state.disturbance, state.disturbance_std};
+  const Vector6d hold = filter_.SafeStopCommand(state.q, state.qd, disturbance, &hold_diagnostics_);
+  if (mode.state == SupervisorState::kHold) {
+    counters_->Count("hold_commands");
+    SafetyOutput out = Emit(hold, sample_utime, hold_diagnostics_.flags, 0, mode);
+    out.diagnostics = &hold_diagnostics_;
+    return out;
+  }
+  // ARMING: both ends satisfy the CBF conditions, linear in F, so the blend
+  // does too.
+  const Vector6d blended = (1.0 - mode.blend) * hold + mode.blend * force_n;
+  return Emit(blended, sample_utime, diagnostics_.flags, 0, mode);
+}
+
+SafetyOutput SafetyProcess::Emit(const Vector6d& force_n, int64_t sample_utime, int32_t flags,
+                                 int32_t fallback_reason, const SupervisorMode& mode) {
   last_published_sample_utime_ = sample_utime;
   SafetyOutput out;
   out.command.utime = sample_utime;
   out.command.seq = seq_++;
   out.command.sample_utime = sample_utime;
   out.command.force_n = force_n;
-  out.command.flags = diagnostics_.flags | fallback_reason;
+  out.command.flags = flags;
   out.fallback_reason = fallback_reason;
+  out.mode = mode;
   out.diagnostics = &diagnostics_;
   counters_->CountOut();
   // For monitors that follow the run from the heartbeat alone.

@@ -85,8 +85,12 @@ ClosedLoopSummary RunClosedLoop(const StackConfig& config, const Scenario& scena
                              config.home_pose, &estimator_counters);
   ControllerProcess controller(config.platform, config.controller, config.home_pose, scenario,
                                &controller_counters);
-  safety::SafetyProcess safety(config.platform, config.safety, config.actuators, options.reference,
-                               &safety_counters);
+  // A simulation: the supervisor arms by itself, as tools/launch.sh has it
+  // do in simulation (no operator in the loop).
+  safety::SupervisorConfig supervisor = config.supervisor;
+  supervisor.auto_arm = true;
+  safety::SafetyProcess safety(config.platform, config.safety, config.actuators, supervisor,
+                               options.reference, &safety_counters);
 
   const std::int64_t period_us = std::llround(1e6 / sensors.rate_hz);
   const long ticks = std::lround(options.duration_s * 1e6 / static_cast<double>(period_us));
@@ -94,8 +98,10 @@ ClosedLoopSummary RunClosedLoop(const StackConfig& config, const Scenario& scena
   out.period_s = static_cast<double>(period_us) * 1e-6;
   for (std::string& name : LimitNames(config.safety)) out.limit_margins.push_back({name});
   // Plant::Advance throws when SUNDIALS fails: the run ends there, reported.
+  bool drive_off = true;  // power-on: DISARMED until the first command says otherwise
   auto advance = [&](const Vector6d& force_n) {
-    plant.SetForceCommand(force_n);
+    plant.SetActuatorsOff(drive_off);
+    if (!drive_off) plant.SetForceCommand(force_n);
     plant.SetExternalWrench(disturbance.WrenchAt(plant.time_s()));
     try {
       plant.Advance(static_cast<double>(period_us) * 1e-6);
@@ -181,6 +187,15 @@ ClosedLoopSummary RunClosedLoop(const StackConfig& config, const Scenario& scena
       }
     } else if (has_safe) {
       f_safe = safe.command.force_n;
+    }
+    if (has_safe) {
+      drive_off = (safe.command.flags & kCommandDriveOff) != 0;
+      // The controller's scenario runs on the supervisor's motion clock,
+      // which it receives after this step (as over LCM in lockstep).
+      const safety::Supervisor& sup = safety.supervisor();
+      controller.OnSupervisor(sup.utime(), sup.motion_time_us(),
+                              sup.state() == safety::SupervisorState::kArming ||
+                                  sup.state() == safety::SupervisorState::kArmed);
     }
     const safety::SafetyDiagnostics* d = has_safe ? safe.diagnostics : nullptr;
     if (d != nullptr) {

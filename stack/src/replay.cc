@@ -240,8 +240,8 @@ SafetyReplayResult ReplaySafety(const StackConfig& config, const RecordedLog& lo
   SafetyReplayResult r;
   // The process's own class, built exactly as the live node built it.
   HealthCounters counters("safety replay");
-  safety::SafetyProcess process(config.platform, config.safety, config.actuators, reference,
-                                &counters);
+  safety::SafetyProcess process(config.platform, config.safety, config.actuators, config.supervisor,
+                                reference, &counters);
   const safety::SafetyFilter& filter = process.filter();
   r.variant = filter.variant();
   if (r.variant == SafetyVariant::kQpReference && reference != nullptr) {

@@ -96,13 +96,23 @@ class ReplayCli : public ::testing::Test {
     const std::string run = root_ + "/" + name;
     fs::create_directories(run);
     const std::string config_path = std::string(STEWART_SOURCE_DIR) + "/config/platform.yaml";
-    fs::copy_file(config_path, run + "/config.yaml");
+    {
+      // A simulated run: the supervisor arms by itself (as tools/launch.sh
+      // has it in simulation).
+      std::ifstream in(config_path);
+      std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+      const std::string off = "auto_arm: false";
+      EXPECT_NE(text.find(off), std::string::npos);
+      if (text.find(off) != std::string::npos)
+        text.replace(text.find(off), off.size(), "auto_arm: true");
+      std::ofstream(run + "/config.yaml") << text;
+    }
     std::ofstream(run + "/run.yaml") << "variant: closed_form\n";
-    StackConfig config = LoadStackConfig(config_path);
+    StackConfig config = LoadStackConfig(run + "/config.yaml");
     config.safety.variant = SafetyVariant::kClosedForm;
     HealthCounters counters("safety");
-    safety::SafetyProcess process(config.platform, config.safety, config.actuators, nullptr,
-                                  &counters);
+    safety::SafetyProcess process(config.platform, config.safety, config.actuators,
+                                  config.supervisor, nullptr, &counters);
     const ChannelNames& ch = config.lcm.channels;
 
     lcm::LogFile log(run + "/log.lcm", "w");

@@ -13,10 +13,22 @@
 namespace stewart::safety::test {
 namespace {
 
+// Arms at the first filtered step, at once: these tests are about the order
+// of messages, not about arming.
+SupervisorConfig ArmedAtOnce() {
+  SupervisorConfig c;
+  c.auto_arm = true;
+  c.arming_ramp_s = 0.0;
+  c.fallback_latch_s = 0.0;
+  return c;
+}
+
 struct Answer {
   int64_t sample_utime;
   Vector6d force_n;
   int32_t flags;
+  int32_t fallback_reason;  ///< 0: the nominal command was filtered (fresh)
+  SupervisorState state;
 };
 
 // Steps `samples` states from start-up, each with its nominal command, in
@@ -24,7 +36,7 @@ struct Answer {
 std::vector<Answer> Answers(const std::vector<bool>& nominal_first) {
   const StackConfig& c = DefaultConfig();
   HealthCounters counters("safety order test");
-  SafetyProcess process(c.platform, c.safety, c.actuators, nullptr, &counters);
+  SafetyProcess process(c.platform, c.safety, c.actuators, ArmedAtOnce(), nullptr, &counters);
   const Vector6d q = c.home_pose;
   const Vector6d f_des = HoverForce(q) + Vector6d::Constant(0.5);
   std::vector<Answer> answers;
@@ -41,7 +53,8 @@ std::vector<Answer> Answers(const std::vector<bool>& nominal_first) {
     SafetyOutput out;
     const auto keep = [&](bool answered) {
       if (answered)
-        answers.push_back({out.command.sample_utime, out.command.force_n, out.command.flags});
+        answers.push_back({out.command.sample_utime, out.command.force_n, out.command.flags,
+                           out.fallback_reason, out.mode.state});
     };
     if (nominal_first[k]) {
       keep(process.OnNominal(nominal, &out));
@@ -84,7 +97,7 @@ TEST(SafetyProcessOrder, StateOrNominalFirstGiveTheSameCommands) {
 std::vector<Answer> AnswersAcrossARestart(bool answers_late) {
   const StackConfig& c = DefaultConfig();
   HealthCounters counters("safety restart order test");
-  SafetyProcess process(c.platform, c.safety, c.actuators, nullptr, &counters);
+  SafetyProcess process(c.platform, c.safety, c.actuators, ArmedAtOnce(), nullptr, &counters);
   const Vector6d q = c.home_pose;
   const Vector6d f_des = HoverForce(q) + Vector6d::Constant(0.5);
   constexpr int kUsableBefore = 5, kUnusable = 30, kUsableAfter = 6;
@@ -93,7 +106,8 @@ std::vector<Answer> AnswersAcrossARestart(bool answers_late) {
   SafetyOutput out;
   const auto keep = [&](bool answered) {
     if (answered)
-      answers.push_back({out.command.sample_utime, out.command.force_n, out.command.flags});
+      answers.push_back({out.command.sample_utime, out.command.force_n, out.command.flags,
+                         out.fallback_reason, out.mode.state});
   };
   const auto nominal_of = [&](int64_t sample_utime) {
     ForceCommand nominal;
@@ -135,13 +149,19 @@ TEST(SafetyProcessOrder, AfterAnEstimatorRestartLateAnswersGiveTheSameCommands) 
     EXPECT_EQ(late[i].sample_utime, prompt[i].sample_utime) << i;
     EXPECT_EQ(late[i].force_n, prompt[i].force_n) << i;
     EXPECT_EQ(late[i].flags, prompt[i].flags) << i;
+    EXPECT_EQ(late[i].fallback_reason, prompt[i].fallback_reason) << i;
+    EXPECT_EQ(late[i].state, prompt[i].state) << i;
   }
   // The unusable states got the fallback, the first usable one after them
-  // its filtered nominal.
+  // its nominal filtered (fresh, not the watchdog's stale input); the
+  // supervisor holds the platform after the gap until an operator resumes.
+  EXPECT_EQ(prompt[4].state, SupervisorState::kArmed);
   EXPECT_TRUE(prompt[5].flags & kCommandFallback);
+  EXPECT_NE(prompt[5].fallback_reason, 0);
   EXPECT_TRUE(prompt[34].flags & kCommandFallback);
-  EXPECT_FALSE(prompt[35].flags & kCommandFallback);
-  EXPECT_FALSE(prompt[36].flags & kCommandFallback);
+  EXPECT_EQ(prompt[35].fallback_reason, 0);
+  EXPECT_EQ(prompt[36].fallback_reason, 0);
+  EXPECT_EQ(prompt[36].state, SupervisorState::kHold);
 }
 
 }  // namespace

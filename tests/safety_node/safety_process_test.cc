@@ -1,9 +1,12 @@
-// The real safety process over LCM: a nominal command is filtered and
-// answered with the same sample_utime; when nominal commands stop (the
-// controller died), each new state is answered with the flagged fallback.
+// The real safety process over LCM: DISARMED until it arms by itself
+// (simulation's auto-arm), then a nominal command is filtered and answered
+// with the same sample_utime; when nominal commands stop (the controller
+// died), each new state is answered with the flagged fallback, and the
+// platform stays held when the controller comes back.
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -13,6 +16,7 @@
 #include "stewart/node/eigen_msg.h"
 #include "stewart/node/lcm_handle.h"
 #include "stewart/state_t.hpp"
+#include "stewart/supervisor_state_t.hpp"
 #include "stewart/test_support/child_process.h"
 #include "stewart/test_support/lcm_messages.h"
 
@@ -42,7 +46,13 @@ TEST(SafetyProcess, FiltersNominalAndFallsBackWhenControllerStops) {
   auto lcm = MakeLcm(url);
   test::Inbox<force_command_t> sink;
   lcm->subscribe(config.lcm.channels.command_safe, &test::Inbox<force_command_t>::On, &sink);
-  test::ChildProcess process({SAFETY_PATH, "--lcm-url", url, "--log-level", "warn"});
+  test::Inbox<supervisor_state_t> supervisor;
+  lcm->subscribe(config.lcm.channels.supervisor, &test::Inbox<supervisor_state_t>::On, &supervisor);
+  const std::string overlay = ::testing::TempDir() + "safety_process_test_overlay.yaml";
+  std::ofstream(overlay)
+      << "supervisor:\n  auto_arm: true\n  arming_ramp_s: 0.0\n  fallback_latch_s: 0.0\n";
+  test::ChildProcess process(
+      {SAFETY_PATH, "--lcm-url", url, "--overlay", overlay, "--log-level", "warn"});
   EXPECT_TRUE(process.started());
   // Give the process time to subscribe: resend the first state until the
   // first answer (the fallback: no nominal command has arrived yet).
@@ -55,7 +65,12 @@ TEST(SafetyProcess, FiltersNominalAndFallsBackWhenControllerStops) {
     utime += 1000;
   }
   ASSERT_FALSE(sink.received.empty()) << "safety process never answered";
-  EXPECT_TRUE(sink.received.back().flags & force_command_t::FLAG_FALLBACK);
+  // Answers to the resent states still on their way, and announcements.
+  test::HandleUntil(
+      lcm.get(), [] { return false; }, 0.3, 10);
+  // Power-on is DISARMED: the drive is off until the first filtered step.
+  EXPECT_TRUE(sink.received.back().flags & force_command_t::FLAG_DRIVE_OFF);
+  EXPECT_EQ(FromArray(sink.received.back().force_n), Vector6d::Zero());
 
   // Controller alive: state then nominal (the gravity-holding force at rest
   // violates nothing), answered unchanged with the same sample_utime.
@@ -81,15 +96,21 @@ TEST(SafetyProcess, FiltersNominalAndFallsBackWhenControllerStops) {
     }
     const std::size_t before = sink.received.size();
     if (k == 0) {
-      lcm->handleTimeout(200);
+      WaitFor(lcm.get(), sink, before + 1);  // the fallback's answer to this state
       continue;
     }
     ASSERT_TRUE(WaitFor(lcm.get(), sink, before + 1));
     const force_command_t& safe = sink.received.back();
     EXPECT_EQ(safe.sample_utime, utime);
-    EXPECT_EQ(safe.flags & force_command_t::FLAG_FALLBACK, 0);
+    EXPECT_EQ(safe.flags & (force_command_t::FLAG_FALLBACK | force_command_t::FLAG_DRIVE_OFF), 0);
     EXPECT_NEAR((FromArray(safe.force_n) - f_hold).norm(), 0.0, 1e-9);
   }
+  // The session: announced before the commands, carried by each of them.
+  ASSERT_FALSE(supervisor.received.empty());
+  const int64_t session = supervisor.received.front().session_id;
+  EXPECT_NE(session, 0);
+  EXPECT_EQ(supervisor.received.back().state, int8_t{supervisor_state_t::STATE_ARMED});
+  for (const force_command_t& c : sink.received) EXPECT_EQ(c.session_id, session);
 
   // Controller killed: states keep coming, nominal commands stop. Within
   // stale_age_s of state time every state is answered by the fallback.
@@ -116,6 +137,27 @@ TEST(SafetyProcess, FiltersNominalAndFallsBackWhenControllerStops) {
   }
   ASSERT_TRUE(fallback_seen);
   EXPECT_LE(utime - last_nominal, stale_us + 1000) << "fallback later than the configured age";
+
+  // The controller is back: the supervisor latched HOLD, so the answers stay
+  // the safe stop until an operator resumes.
+  for (int k = 0; k < 20; ++k) {
+    utime += 1000;
+    const state_t s = MakeState(utime, q);
+    force_command_t nominal{};
+    nominal.utime = nominal.sample_utime = utime;
+    nominal.seq = 100 + k;
+    ToArray(f_hold, nominal.force_n);
+    const std::size_t before = sink.received.size();
+    lcm->publish(config.lcm.channels.state_estimate, &s);
+    lcm->publish(config.lcm.channels.command_nominal, &nominal);
+    ASSERT_TRUE(WaitFor(lcm.get(), sink, before + 1));
+    EXPECT_TRUE(sink.received.back().flags & force_command_t::FLAG_FALLBACK) << k;
+  }
+  test::HandleUntil(
+      lcm.get(), [&] { return supervisor.received.back().state == supervisor_state_t::STATE_HOLD; },
+      1.0);
+  EXPECT_EQ(supervisor.received.back().state, int8_t{supervisor_state_t::STATE_HOLD});
+  EXPECT_EQ(supervisor.received.back().fault_latched, 1);
 }
 
 }  // namespace

@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -46,7 +47,11 @@ TEST(ControllerKill, SafetyFallsBackWithinTheStaleAgeAndThePlantKeepsGettingComm
   lcm->subscribe(config.lcm.channels.command_safe, &Sink::OnSafe, &sink)->setQueueCapacity(100000);
   lcm->subscribe(config.lcm.channels.command_nominal, &Sink::OnNominal, &sink)
       ->setQueueCapacity(100000);
-  const std::vector<std::string> common = {"--lcm-url", url, "--log-level", "warn"};
+  // A simulation: the supervisor arms by itself (as tools/launch.sh has it).
+  const std::string overlay = ::testing::TempDir() + "controller_kill_overlay.yaml";
+  std::ofstream(overlay) << "supervisor:\n  auto_arm: true\n";
+  const std::vector<std::string> common = {"--lcm-url", url,           "--overlay",
+                                           overlay,     "--log-level", "warn"};
   auto with = [&](std::vector<std::string> head) {
     head.insert(head.end(), common.begin(), common.end());
     return head;

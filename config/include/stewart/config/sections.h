@@ -14,6 +14,7 @@
 #include "stewart/node/lcm_config.h"
 #include "stewart/plant_sim/plant_sim_config.h"
 #include "stewart/safety/safety_config.h"
+#include "stewart/safety/supervisor.h"
 
 namespace stewart {
 
@@ -30,5 +31,6 @@ HwBridgeConfig ParseHwBridgeConfig(const ConfigNode& hw_bridge, const ActuatorCo
 LcmConfig ParseLcmConfig(const ConfigNode& lcm, const ConfigNode& rates);
 /// `guard`: what the actuators accept and where they stop on their own.
 GuardConfig ParseGuardConfig(const ConfigNode& guard);
+safety::SupervisorConfig ParseSupervisorConfig(const ConfigNode& supervisor);
 
 }  // namespace stewart

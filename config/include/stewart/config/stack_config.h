@@ -16,6 +16,7 @@
 #include "stewart/plant_sim/plant_sim_config.h"
 #include "stewart/plant_sim/truth.h"
 #include "stewart/safety/safety_config.h"
+#include "stewart/safety/supervisor.h"
 
 namespace stewart {
 
@@ -26,6 +27,7 @@ struct StackConfig {
   SensorConfig sensors;
   ControllerConfig controller;
   SafetyConfig safety;
+  safety::SupervisorConfig supervisor;
   EstimatorConfig estimator;
   PlantSimConfig plant_sim;
   HwBridgeConfig hw_bridge;

@@ -40,7 +40,8 @@ struct ControllerOutput {
   bool setpoint_rejected = false;
   /// Scenario mode: this step's scenario sample was rejected (count it).
   std::optional<SetpointStatus> scenario_rejection;
-  double scenario_time_s = 0.0;  ///< t since the first valid state (s)
+  double scenario_time_s =
+      0.0;  ///< scenario time t (s): the motion clock, else since the first valid state
 };
 
 class Controller {
@@ -63,6 +64,17 @@ class Controller {
   StepStatus Step(int64_t utime, const Vector6d& q, const Vector6d& qd,
                   const Vector6d& disturbance_n, ControllerOutput* out);
 
+  /// The supervisor's motion clock (supervisor_state_t): at stack time
+  /// `utime` (us) the platform had moved for `motion_time_us`, and keeps
+  /// moving (`running`: ARMING or ARMED) or not. From the first call on, a
+  /// scenario runs on this clock instead of the time since the first state:
+  /// it pauses while the platform holds, and a restarted controller takes
+  /// the scenario up where the motion was, not from t = 0.
+  void SetMotionClock(int64_t utime, int64_t motion_time_us, bool running);
+  /// Makes the scenario start at t = 0 at the motion clock's first reading
+  /// (a scenario replayed from its start after this process restarts).
+  void RestartScenarioAtFirstMotionClock() { restart_at_first_clock_ = true; }
+
   bool following_scenario() const { return scenario_.has_value(); }
   const std::optional<Scenario>& scenario() const { return scenario_; }
   /// True once a state at t >= duration_s has been processed.
@@ -80,6 +92,14 @@ class Controller {
   bool rejected_ = false;
   bool scenario_finished_ = false;
   std::optional<int64_t> first_utime_;
+  struct MotionClock {
+    int64_t utime = 0;
+    int64_t motion_time_us = 0;
+    bool running = false;
+  };
+  std::optional<MotionClock> motion_clock_;
+  bool restart_at_first_clock_ = false;
+  int64_t motion_offset_us_ = 0;  ///< subtracted from the motion clock
   std::optional<int64_t> last_utime_;
   DynamicsTerms terms_{};
 };

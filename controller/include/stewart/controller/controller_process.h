@@ -41,6 +41,10 @@ class ControllerProcess {
   ControllerVerdict OnState(const StateSample& state, ControllerProcessOutput* out);
   /// A live setpoint arrived (only without a scenario).
   void OnSetpoint(const Setpoint& setpoint);
+  /// The supervisor's state arrived: its motion clock (Controller::SetMotionClock).
+  void OnSupervisor(int64_t utime, int64_t motion_time_us, bool running);
+  /// The scenario starts over at this process's first supervisor state.
+  void RestartScenario() { controller_.RestartScenarioAtFirstMotionClock(); }
 
   const Controller& controller() const { return controller_; }
 

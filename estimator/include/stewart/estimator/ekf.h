@@ -21,7 +21,9 @@ class Ekf {
 
   /// The leg forces being applied (N) from command sample time `utime` (us):
   /// the process model's input.
-  void SetForceCommand(int64_t utime, const Vector6d& force_n);
+  /// `drive_off`: the command turned the drive off (force_command_t
+  /// FLAG_DRIVE_OFF): the lead screws hold the legs, whatever the actuator.
+  void SetForceCommand(int64_t utime, const Vector6d& force_n, bool drive_off = false);
 
   /// One predict + correct step per sensor sample. Before the first valid leg
   /// reading it initialises from forward kinematics.
@@ -92,6 +94,7 @@ class Ekf {
   struct TimedCommand {
     int64_t utime = 0;
     Vector6d force_n = Vector6d::Zero();
+    bool drive_off = false;  ///< the supervisor turned the drive off: legs held
   };
   static constexpr int kCommandHistory = 16;
   std::array<TimedCommand, kCommandHistory> command_history_{};

@@ -23,10 +23,6 @@ struct GuardConfig {
   double session_silence_s = 0.3;
   /// ... or in wall time (s): in lockstep, stack time stops with the loop.
   double session_silence_wall_s = 1.5;
-
-  /// An operator command whose utime (the operator's wall clock) differs
-  /// from the receiver's wall clock by more than this is not believed (s).
-  double operator_max_age_s = 2.0;
 };
 
 }  // namespace stewart

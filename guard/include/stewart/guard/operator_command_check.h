@@ -2,7 +2,7 @@
 // Which operator commands (operator_command_t on OPERATOR) an actuator
 // believes: only RESET concerns it (clearing its guard's latch), and a RESET
 // moves the platform again, so it must be authentic (MAC), recent by the
-// receiver's wall clock (operator_max_age_s either way: the operator's
+// receiver's wall clock (supervisor.operator_time_window_s either way: the operator's
 // console stamps its wall clock) and newer than the last one of the same
 // console (seq per operator_id), so a replayed log clears nothing.
 // No LCM, no allocation: a fixed table of the last consoles seen.

@@ -10,6 +10,7 @@ enum class ExitCode : int {
   kBadInput = 2,            ///< bad config, truth or command-line argument
   kLockstepTimeout = 3,     ///< plant_sim lockstep: no command within the timeout
   kIntegrationFailure = 4,  ///< plant_sim: the integrator failed
+  kRefused = 5,             ///< stewart_ctl: the supervisor refused the command
 };
 
 constexpr int ToInt(ExitCode code) { return static_cast<int>(code); }

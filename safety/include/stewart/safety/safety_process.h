@@ -13,6 +13,7 @@
 #include "stewart/common/health_counters.h"
 #include "stewart/common/signals.h"
 #include "stewart/safety/safety_filter.h"
+#include "stewart/safety/supervisor.h"
 
 namespace stewart::safety {
 
@@ -23,17 +24,22 @@ struct SafetyOutput {
   /// (watchdog or stale nominal), kCommandInvalidInput (state not usable),
   /// or 0 for a filtered nominal command.
   int32_t fallback_reason = 0;
+  /// The supervisor's mode the command was shaped by (supervisor.h).
+  SupervisorMode mode;
   const SafetyDiagnostics* diagnostics = nullptr;  ///< valid until the next call
 };
 
 class SafetyProcess {
  public:
   /// `counters` receives rejections and the process counters
-  /// (fallback_commands, active_steps, infeasible, nominal_before_state) and
-  /// must outlive this object; `reference` as for SafetyFilter.
+  /// (fallback_commands, active_steps, infeasible, nominal_before_state,
+  /// hold_commands, drive_off_commands) and must outlive this object;
+  /// `reference` as for SafetyFilter. Every command goes through the
+  /// supervisor: DISARMED and ESTOP turn the drive off, HOLD sends the safe
+  /// stop, ARMING blends the safe stop into the filtered command.
   SafetyProcess(const PlatformParams& platform, const SafetyConfig& safety,
-                const ActuatorConfig& actuators, ReferenceQpSolver* reference,
-                HealthCounters* counters);
+                const ActuatorConfig& actuators, const SupervisorConfig& supervisor,
+                ReferenceQpSolver* reference, HealthCounters* counters);
 
   /// A state estimate arrived. Returns true when `out` holds a command to
   /// publish: the pending nominal command for this state, filtered; or a
@@ -45,6 +51,10 @@ class SafetyProcess {
   bool OnNominal(const ForceCommand& nominal, SafetyOutput* out);
 
   const SafetyFilter& filter() const { return filter_; }
+  /// The supervisor, for operator commands and outside faults (the node,
+  /// replay).
+  Supervisor& supervisor() { return supervisor_; }
+  const Supervisor& supervisor() const { return supervisor_; }
   int64_t stale_age_us() const { return stale_age_us_; }
 
  private:
@@ -55,10 +65,17 @@ class SafetyProcess {
   /// kCommandInvalidInput).
   SafetyOutput Fallback(const StateSample& state, int32_t reason);
   const StateSample* FindState(int64_t sample_utime) const;
+  /// The supervisor's step, then its mode applied to `force_n` (the
+  /// filtered command or the safe stop) at `state`.
+  SafetyOutput Supervise(const StateSample& state, const Vector6d& force_n, int64_t sample_utime,
+                         int32_t fallback_reason);
   /// Publishing bookkeeping shared by every output.
-  SafetyOutput Emit(const Vector6d& force_n, int64_t sample_utime, int32_t fallback_reason);
+  SafetyOutput Emit(const Vector6d& force_n, int64_t sample_utime, int32_t flags,
+                    int32_t fallback_reason, const SupervisorMode& mode);
 
   SafetyFilter filter_;
+  Supervisor supervisor_;
+  SafetyDiagnostics hold_diagnostics_{};  // the safe stop blended in while ARMING
   HealthCounters* counters_;
   const int64_t stale_age_us_;
 
