@@ -43,22 +43,23 @@ CommandGate::Decision CommandGate::Check(const ForceCommand& c, bool authentic) 
                       std::to_string(newest_sample_utime_) + ")",
                   false);
   }
-  const std::string utime = std::to_string(c.sample_utime);
-  const std::string awaited = std::to_string(newest_sample_utime_);
+  // Strings only on the rejection paths: an accepted command allocates nothing.
+  const auto utime = [&c] { return std::to_string(c.sample_utime); };
+  const auto awaited = [this] { return std::to_string(newest_sample_utime_); };
   if (lockstep_) {
     switch (MatchLockstepCommand(newest_sample_utime_, c.sample_utime)) {
       case LockstepMatch::kAnswer:
-        if (answered_) return Reject("duplicate_answer", "sample_utime " + utime, true);
+        if (answered_) return Reject("duplicate_answer", "sample_utime " + utime(), true);
         answered_ = true;
         answer_ = c;
         return Accept(Action::kAnswer);
       case LockstepMatch::kStale:
-        return Reject("stale_sample_utime", utime + " < awaited " + awaited, true);
+        return Reject("stale_sample_utime", utime() + " < awaited " + awaited(), true);
       case LockstepMatch::kFuture:
-        return Reject("future_sample_utime", utime + " > awaited " + awaited, true);
+        return Reject("future_sample_utime", utime() + " > awaited " + awaited(), true);
     }
   }
-  if (c.sample_utime < last_applied_sample_utime_) return Reject("out_of_order", utime, true);
+  if (c.sample_utime < last_applied_sample_utime_) return Reject("out_of_order", utime(), true);
   last_applied_sample_utime_ = c.sample_utime;
   return Accept(Action::kApply);
 }
