@@ -12,20 +12,21 @@ SafetyNode::SafetyNode(const StackConfig& config, lcm::LCM* lcm,
       lcm_(lcm),
       receiver_(config.lcm.url),
       health_("safety", config.lcm.channels.health, config.lcm.health_rate_hz),
-      process_(config.platform, config.safety, config.actuators, reference, &health_) {
+      process_(config.platform, config.safety, config.actuators, reference, &health_,
+               config.lcm.time_plausibility) {
   receiver_.Subscribe(config.lcm.channels.state_estimate, &SafetyNode::OnState, this);
   receiver_.Subscribe(config.lcm.channels.command_nominal, &SafetyNode::OnNominal, this);
 }
 
-void SafetyNode::OnState(const lcm::ReceiveBuffer*, const std::string&, const state_t* msg) {
+void SafetyNode::OnState(const lcm::ReceiveBuffer* rbuf, const std::string&, const state_t* msg) {
   safety::SafetyOutput out;
-  if (process_.OnState(FromMessage(*msg), &out)) Publish(out);
+  if (process_.OnState(FromMessage(*msg), &out, rbuf->recv_utime)) Publish(out);
 }
 
-void SafetyNode::OnNominal(const lcm::ReceiveBuffer*, const std::string&,
+void SafetyNode::OnNominal(const lcm::ReceiveBuffer* rbuf, const std::string&,
                            const force_command_t* msg) {
   safety::SafetyOutput out;
-  if (process_.OnNominal(FromMessage(*msg), &out)) Publish(out);
+  if (process_.OnNominal(FromMessage(*msg), &out, rbuf->recv_utime)) Publish(out);
 }
 
 void SafetyNode::Publish(const safety::SafetyOutput& out) {

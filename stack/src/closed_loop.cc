@@ -82,11 +82,11 @@ ClosedLoopSummary RunClosedLoop(const StackConfig& config, const Scenario& scena
   HealthCounters estimator_counters("estimator"), controller_counters("controller"),
       safety_counters("safety");
   EstimatorProcess estimator(config.platform, config.actuators, sensors, config.estimator,
-                             config.home_pose, &estimator_counters);
+                             config.home_pose, &estimator_counters, config.lcm.time_plausibility);
   ControllerProcess controller(config.platform, config.controller, config.home_pose, scenario,
-                               &controller_counters);
+                               &controller_counters, config.lcm.time_plausibility);
   safety::SafetyProcess safety(config.platform, config.safety, config.actuators, options.reference,
-                               &safety_counters);
+                               &safety_counters, config.lcm.time_plausibility);
 
   const std::int64_t period_us = std::llround(1e6 / sensors.rate_hz);
   const long ticks = std::lround(options.duration_s * 1e6 / static_cast<double>(period_us));

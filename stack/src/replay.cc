@@ -240,8 +240,10 @@ SafetyReplayResult ReplaySafety(const StackConfig& config, const RecordedLog& lo
   SafetyReplayResult r;
   // The process's own class, built exactly as the live node built it.
   HealthCounters counters("safety replay");
+  // No receive times: the time checks judge message times only, so a log
+  // replays to the same outputs whenever and however fast it is replayed.
   safety::SafetyProcess process(config.platform, config.safety, config.actuators, reference,
-                                &counters);
+                                &counters, config.lcm.time_plausibility);
   const safety::SafetyFilter& filter = process.filter();
   r.variant = filter.variant();
   if (r.variant == SafetyVariant::kQpReference && reference != nullptr) {
@@ -403,7 +405,7 @@ ControllerReplayResult ReplayController(const StackConfig& config, const Scenari
   r.scenario = scenario.name();
   HealthCounters counters("controller replay");
   ControllerProcess process(config.platform, config.controller, config.home_pose, scenario,
-                            &counters);
+                            &counters, config.lcm.time_plausibility);
   Pairing<force_command_t> recorded_commands(log.nominal, &r.commands);
   const std::optional<int64_t> origin = ControllerTimeOrigin(log, &r.time_origin_inferred);
   r.time_origin_utime = origin.value_or(-1);
@@ -426,7 +428,8 @@ ControllerReplayResult ReplayController(const StackConfig& config, const Scenari
       continue;
     }
     started = true;
-    if (verdict == ControllerVerdict::kStepRejected) {
+    if (verdict == ControllerVerdict::kStepRejected ||
+        verdict == ControllerVerdict::kTimeImplausible) {
       ++r.step_rejected;
       continue;
     }
@@ -502,7 +505,7 @@ EstimatorReplayResult ReplayEstimator(const StackConfig& config, const RecordedL
   Pairing<state_t> recorded_estimates(log.estimates, &r.estimates);
   HealthCounters counters("estimator replay");
   EstimatorProcess process(config.platform, config.actuators, config.sensors, config.estimator,
-                           config.home_pose, &counters);
+                           config.home_pose, &counters, config.lcm.time_plausibility);
   auto compare = [&](const StateSample& sample) {
     state_t replayed{};
     ToMessage(sample, &replayed);
