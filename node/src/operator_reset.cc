@@ -44,20 +44,31 @@ bool OperatorResetFilter::OnCommand(const operator_command_t& msg, int64_t recei
   return true;
 }
 
-OperatorResetListener::OperatorResetListener(const LcmConfig& lcm)
-    : receiver_(lcm.url),
+OperatorResets::OperatorResets(const LcmConfig& lcm)
+    : url_(lcm.url),
+      channel_(lcm.channels.operator_command),
       filter_(MessageAuthenticator::FromKeyFile(lcm.auth_key_file),
-              lcm.time_plausibility.window_s) {
-  receiver_.Subscribe(lcm.channels.operator_command, &OperatorResetListener::OnOperator, this);
+              lcm.time_plausibility.window_s) {}
+
+void OperatorResets::Attach(LcmReceiver* receiver) {
+  receiver->Subscribe(channel_, &OperatorResets::OnOperator, this);
+  attached_ = true;
 }
 
-void OperatorResetListener::Poll() {
-  while (receiver_.HandleTimeout(0) > 0) {
+OperatorResetCounts OperatorResets::Poll() {
+  if (!attached_) {
+    if (!own_receiver_) {
+      own_receiver_ = std::make_unique<LcmReceiver>(url_);
+      own_receiver_->Subscribe(channel_, &OperatorResets::OnOperator, this);
+    }
+    while (own_receiver_->HandleTimeout(0) > 0) {
+    }
   }
+  return filter_.counts();
 }
 
-void OperatorResetListener::OnOperator(const lcm::ReceiveBuffer* rbuf, const std::string&,
-                                       const operator_command_t* msg) {
+void OperatorResets::OnOperator(const lcm::ReceiveBuffer* rbuf, const std::string&,
+                                const operator_command_t* msg) {
   if (filter_.OnCommand(*msg, rbuf->recv_utime)) {
     spdlog::info("operator {} RESET (seq {}): latched faults acknowledged", msg->operator_id,
                  msg->seq);
@@ -65,21 +76,23 @@ void OperatorResetListener::OnOperator(const lcm::ReceiveBuffer* rbuf, const std
 }
 
 namespace {
-std::unique_ptr<OperatorResetListener>& Installed() {
-  static std::unique_ptr<OperatorResetListener> listener;
-  return listener;
+std::unique_ptr<OperatorResets>& Installed() {
+  static std::unique_ptr<OperatorResets> resets;
+  return resets;
 }
 }  // namespace
 
 void InstallOperatorResetListener(const LcmConfig& lcm) {
-  Installed() = std::make_unique<OperatorResetListener>(lcm);
+  Installed() = std::make_unique<OperatorResets>(lcm);
+}
+
+void AttachOperatorResets(LcmReceiver* receiver) {
+  if (Installed()) Installed()->Attach(receiver);
 }
 
 OperatorResetCounts PollOperatorResets() {
-  OperatorResetListener* listener = Installed().get();
-  if (listener == nullptr) return {};
-  listener->Poll();
-  return listener->counts();
+  OperatorResets* resets = Installed().get();
+  return resets == nullptr ? OperatorResetCounts{} : resets->Poll();
 }
 
 }  // namespace stewart

@@ -10,10 +10,12 @@
 // so a recorded RESET played back later acknowledges nothing. Every other
 // command on the channel is the supervisor's business and ignored here.
 //
-// NodeMain installs one listener per process (its own socket on the bus,
-// filtered by the kernel to the operator channel), and every HealthReporter
-// of the process polls it when it beats: a RESET acknowledges the faults at
-// the next heartbeat, which shows it. No node has to subscribe to anything.
+// NodeMain installs one listener per process; the node's loop attaches its
+// receiver to it (RunNodeLoop does; a node with a loop of its own may call
+// AttachOperatorResets), else it reads a socket of its own, filtered by the
+// kernel to the operator channel. Every HealthReporter of the process polls
+// it when it beats: a RESET acknowledges the faults at the next heartbeat,
+// which shows it.
 #include <array>
 #include <cstdint>
 #include <memory>
@@ -55,25 +57,38 @@ class OperatorResetFilter {
   OperatorResetCounts counts_;
 };
 
-/// An OperatorResetFilter on its own socket.
-class OperatorResetListener {
+/// The process's RESETs: one OperatorResetFilter on the operator channel,
+/// fed by the node's own receiver when it attaches one (no extra socket:
+/// every extra socket on the bus costs the kernel a copy of every datagram),
+/// else by a socket of its own, opened at the first poll.
+class OperatorResets {
  public:
-  /// Throws std::runtime_error for a bad key file or a socket that cannot join.
-  explicit OperatorResetListener(const LcmConfig& lcm);
-  /// Handles what arrived, without waiting.
-  void Poll();
-  const OperatorResetCounts& counts() const { return filter_.counts(); }
+  /// Throws std::runtime_error for a bad key file.
+  explicit OperatorResets(const LcmConfig& lcm);
+  /// `receiver` (on this process's URL) takes the operator channel too.
+  void Attach(LcmReceiver* receiver);
+  /// Handles what arrived on the own socket (when none is attached), without
+  /// waiting; the counts so far. Throws std::runtime_error when the own
+  /// socket cannot join the bus.
+  OperatorResetCounts Poll();
 
   void OnOperator(const lcm::ReceiveBuffer* rbuf, const std::string& channel,
                   const operator_command_t* msg);
 
  private:
-  LcmReceiver receiver_;
+  std::string url_;
+  std::string channel_;
   OperatorResetFilter filter_;
+  bool attached_ = false;
+  std::unique_ptr<LcmReceiver> own_receiver_;
 };
 
-/// NodeMain: the process's listener, on `lcm`'s URL and operator channel.
+/// NodeMain: the process's RESETs, on `lcm`'s URL and operator channel.
 void InstallOperatorResetListener(const LcmConfig& lcm);
+/// A node's receiver takes the operator channel (RunNodeLoop does it): the
+/// process then opens no socket of its own for it. No-op when none is
+/// installed.
+void AttachOperatorResets(LcmReceiver* receiver);
 /// Polls the installed listener: its counts (all 0 when none is installed).
 OperatorResetCounts PollOperatorResets();
 
