@@ -37,7 +37,6 @@ def load(run, channel_key, config):
             if k not in ("name", "counters", "counter_deltas", "last_error", "latched_error")}
 
 
-STATE_NAMES = {0: "starting", 1: "ok", 2: "degraded", 3: "FAULT", 4: "stopped"}
 SEVERITY = {2: 1, 3: 2}  # DEGRADED, FAULT; the other states are no problem
 
 
@@ -62,13 +61,14 @@ def health_section(run, config):
              "| process | worst state | fault latched | rejected | time implausible |",
              "| --- | --- | --- | --- | --- |"]
     for process, beats in sorted(rows.items()):
-        worst = max((int(b["worst_state"]) for b in beats), key=lambda s: SEVERITY.get(s, 0))
+        severity = max(SEVERITY.get(int(b["worst_state"]), 0) for b in beats)
+        worst = {2: "FAULT", 1: "degraded", 0: "ok"}[severity]
         latched = [b for b in beats if b["fault_latched"] == "1"]
         last = beats[-1]
         counters = dict(item.split("=", 1) for item in last["counters"].split(";") if "=" in item)
         implausible = sum(int(v) for k, v in counters.items() if k.endswith("_time_implausible"))
         latched_text = f"yes: {latched[0]['latched_error']}" if latched else "no"
-        lines.append(f"| {process} | {STATE_NAMES.get(worst, worst)} | {latched_text} | "
+        lines.append(f"| {process} | {worst} | {latched_text} | "
                      f"{last['rejected_inputs']} | {implausible} |")
     return lines + [""]
 

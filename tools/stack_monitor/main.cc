@@ -61,7 +61,7 @@ class Monitor {
       const int8_t worst = worst_since_print_.count(name) ? worst_since_print_.at(name) : h.state;
       if (h.rejected_inputs > 0 || Severity(worst) > 0 || h.fault_latched) {
         s << " | " << name << ": state " << StateName(h.state);
-        if (worst != h.state) s << " (" << StateName(worst) << " since)";
+        if (worst != h.state) s << " (" << StateName(worst) << " since the last line)";
         if (h.fault_latched) s << ", FAULT latched (" << h.latched_error << ")";
         s << ", rejected " << h.rejected_inputs << " (+" << h.rejected_inputs_delta << ")";
         if (!h.last_error.empty()) s << " (" << h.last_error << ")";
