@@ -117,9 +117,34 @@ TEST(SupervisorStack, ArmHoldAfterARestartResumeAndEstopWithTheConsole) {
   EXPECT_GT(motion_before_us, 1'500'000);
 
   // The controller dies and comes back: held, and it stays held.
+  const size_t n_states = sink.supervisor.size();
   controller->Stop(SIGKILL);
   pump_for(0.5);
   EXPECT_EQ(last_state(), int8_t{supervisor_state_t::STATE_HOLD});
+  {
+    // Fault to hold, in stack time: the last filtered command, then the
+    // watchdog's fallbacks for supervisor.fallback_latch_s, then HOLD.
+    int64_t last_filtered = -1;
+    for (const force_command_t& c : sink.safe) {
+      if (!Fallback(c)) last_filtered = std::max(last_filtered, c.sample_utime);
+    }
+    int64_t hold_utime = -1;
+    for (size_t i = n_states; i < sink.supervisor.size() && hold_utime < 0; ++i) {
+      if (sink.supervisor[i].state == supervisor_state_t::STATE_HOLD) {
+        hold_utime = sink.supervisor[i].utime;
+      }
+    }
+    ASSERT_GT(last_filtered, 0);
+    ASSERT_GT(hold_utime, 0);
+    const double ms = 1e-3 * static_cast<double>(hold_utime - last_filtered);
+    const double bound_ms =
+        1e3 * (config.safety.stale_age_s + config.supervisor.fallback_latch_s) + 2.0;
+    EXPECT_LE(ms, bound_ms);
+    std::printf(
+        "[supervisor] controller killed: HOLD %.1f ms (stack time) after the last "
+        "filtered command (bound %.1f ms)\n",
+        ms, bound_ms);
+  }
   controller = std::make_unique<test::ChildProcess>(with({CONTROLLER_PATH, "--scenario", "paper"}));
   ASSERT_TRUE(controller->started());
   pump_for(2.0);

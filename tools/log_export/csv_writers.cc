@@ -167,19 +167,32 @@ class DiagnosticsWriter : public TypedWriter<safety_diagnostics_t> {
 
 class HealthWriter : public TypedWriter<health_t> {
   std::string Columns() const override {
-    return ",name,state,messages_in,messages_out,rejected_inputs,counters,last_error";
+    return ",name,state,worst_state,fault_latched,messages_in,messages_out,rejected_inputs,"
+           "period_us,messages_in_delta,messages_out_delta,rejected_inputs_delta,counters,"
+           "counter_deltas,last_error,latched_error";
   }
   void Row(const health_t& m, std::ostream& out) const override {
-    out << ',' << m.name << ',' << int{m.state} << ',' << m.messages_in << ',' << m.messages_out
-        << ',' << m.rejected_inputs << ",\"";
+    out << ',' << m.name << ',' << int{m.state} << ',' << int{m.worst_state} << ','
+        << int{m.fault_latched} << ',' << m.messages_in << ',' << m.messages_out << ','
+        << m.rejected_inputs << ',' << m.period_us << ',' << m.messages_in_delta << ','
+        << m.messages_out_delta << ',' << m.rejected_inputs_delta << ",\"";
     for (std::size_t i = 0; i < m.counter_names.size(); ++i) {
       out << (i ? ";" : "") << m.counter_names[i] << '=' << m.counter_values[i];
     }
-    std::string error = m.last_error;
-    for (char& c : error) {
+    out << "\",\"";
+    for (std::size_t i = 0; i < m.counter_names.size(); ++i) {
+      out << (i ? ";" : "") << m.counter_names[i] << '=' << m.counter_deltas[i];
+    }
+    out << "\",\"" << Quotable(m.last_error) << "\",\"" << Quotable(m.latched_error) << '"';
+  }
+
+ private:
+  /// Free text inside a quoted CSV field: no quote, no line break.
+  static std::string Quotable(std::string text) {
+    for (char& c : text) {
       if (c == '"' || c == '\n') c = '\'';
     }
-    out << "\",\"" << error << '"';
+    return text;
   }
 };
 
