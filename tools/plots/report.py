@@ -73,6 +73,45 @@ def health_section(run, config):
     return lines + [""]
 
 
+SUPERVISOR_STATES = {0: "DISARMED", 1: "ARMING", 2: "ARMED", 3: "HOLD", 4: "ESTOP"}
+
+
+def supervisor_section(run, config):
+    """The supervisor's states through the run (docs/operations.md, "Arming and e-stop"):
+    each change with its stack time and reason, from the recorded supervisor_state_t."""
+    lcm = config["lcm"]
+    channel = lcm["channels"].get("supervisor")
+    if not channel:
+        return []
+    name = lcm["channel_prefix"] + channel + (lcm.get("channel_suffix") or "")
+    path = os.path.join(run, "csv", name + ".csv")
+    if not os.path.exists(path):
+        return []
+    with open(path) as f:
+        rows = list(csv.DictReader(f))
+    if not rows:
+        return []
+    lines = ["## Supervisor", "",
+             "State changes of the supervisor (stack time of the decision; docs/operations.md, "
+             "\"Arming and e-stop\"). The motion clock is the stack time spent ARMING or ARMED.",
+             "", "| t (s) | state | reason |", "| --- | --- | --- |"]
+    previous = None
+    for row in rows:
+        key = (row["state"], row["transitions"])
+        if key == previous:
+            continue
+        previous = key
+        t = int(row["utime_us"]) * 1e-6
+        lines.append(f"| {t:.3f} | {SUPERVISOR_STATES.get(int(row['state']), row['state'])} | "
+                     f"{row['reason']} |")
+    last = rows[-1]
+    lines += ["", f"At the end: {SUPERVISOR_STATES.get(int(last['state']), last['state'])}, "
+              f"motion clock {int(last['motion_time_us']) * 1e-6:.3f} s, operator commands "
+              f"accepted {last['operator_commands_accepted']}, rejected "
+              f"{last['operator_commands_rejected']}.", ""]
+    return lines
+
+
 def plant_counters(run, config):
     """Counters of the plant process (plant_sim or hw_bridge) from its last health message."""
     lcm = config["lcm"]
@@ -268,6 +307,7 @@ def main():
                 if over > 0:
                     exceeded.append(f"{axis} {kind} {side}")
     lines += ["", "Exceeded: " + (", ".join(exceeded) if exceeded else "none"), ""]
+    lines += supervisor_section(run, config)
     lines += health_section(run, config)
 
     if diag is not None:
