@@ -40,6 +40,38 @@ int64_t HealthCounters::counter(const std::string& counter) const {
   return 0;
 }
 
+void HealthCounters::SetState(int8_t state) {
+  if (state != health_state::kFault) naming_latched_fault_ = false;
+  state_ = state;
+  if (health_state::Severity(state) >= health_state::Severity(worst_state_)) worst_state_ = state;
+  if (state == health_state::kFault && !fault_latched_) {
+    fault_latched_ = true;
+    naming_latched_fault_ = true;
+    latched_error_ = last_error_;
+  }
+}
+
+void HealthCounters::SetError(const std::string& error) {
+  last_error_ = error;
+  // A node names its fault before or after entering it: while the fault
+  // that latched lasts, its latest error names it.
+  if (naming_latched_fault_) latched_error_ = error;
+}
+
+bool HealthCounters::AcknowledgeFault() {
+  if (!fault_latched_ || state_ == health_state::kFault) return false;
+  fault_latched_ = false;
+  naming_latched_fault_ = false;
+  latched_error_.clear();
+  return true;
+}
+
+int8_t HealthCounters::TakeWorstState() {
+  const int8_t worst = worst_state_;
+  worst_state_ = state_;
+  return worst;
+}
+
 void HealthCounters::SetStackTime(int64_t utime, int64_t sample_utime) {
   utime_ = utime;
   sample_utime_ = sample_utime;

@@ -14,6 +14,7 @@ ControllerConfig ParseControllerConfig(const ConfigNode& controller) {
   if (controller.Has("compensate_friction")) {
     c.compensate_friction = controller.Bool("compensate_friction");
   }
+  if (controller.Has("stale_age_s")) c.stale_age_s = controller.PositiveDouble("stale_age_s");
   return c;
 }
 

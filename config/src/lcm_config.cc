@@ -21,6 +21,14 @@ LcmConfig ParseLcmConfig(const ConfigNode& lcm, const ConfigNode& rates) {
   SetChannelSuffix(&c, suffix);
   c.health_rate_hz = rates.PositiveDouble("health_hz");
   c.auth_key_file = lcm.Has("auth_key_file") ? lcm.String("auth_key_file") : "";
+  // Optional, so the configs of runs recorded before them still load.
+  if (lcm.Has("time_window_s")) c.time_plausibility.window_s = lcm.PositiveDouble("time_window_s");
+  if (lcm.Has("max_time_rate")) {
+    c.time_plausibility.max_rate = lcm.PositiveDouble("max_time_rate");
+    if (c.time_plausibility.max_rate < 1.0) {
+      lcm.Fail("max_time_rate", "must be >= 1 (stack time runs at least at the wall rate)");
+    }
+  }
   return c;
 }
 

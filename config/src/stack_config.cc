@@ -2,6 +2,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
+#include <utility>
 
 #include "stewart/config/config_loader.h"
 #include "stewart/config/sections.h"
@@ -84,6 +85,26 @@ void ValidateStackConfig(const StackConfig& c) {
     if (limit.lower && !(home > *limit.lower)) {
       throw ConfigError(key + ".lower",
                         "excludes the home pose (" + axis + " = " + Fmt(home) + ")");
+    }
+  }
+  // The time window must hold every input gap a process tolerates by its
+  // own rules, so it rejects only implausible times, never merely old ones.
+  const double window_s = c.lcm.time_plausibility.window_s;
+  if (!std::isfinite(window_s)) throw ConfigError("lcm.time_window_s", "must be finite");
+  if (!std::isfinite(c.lcm.time_plausibility.max_rate)) {
+    throw ConfigError("lcm.max_time_rate", "must be finite");
+  }
+  const std::pair<const char*, double> tolerated_gaps_s[] = {
+      {"safety.stale_age_s", c.safety.stale_age_s},
+      {"controller.stale_age_s", c.controller.stale_age_s},
+      {"estimator.max_dt_s", c.estimator.max_dt_s},
+      {"estimator.command_timeout_s", c.estimator.command_timeout_s},
+      {"plant_sim.command_timeout_s", c.plant_sim.command_timeout_s},
+      {"hw_bridge.command_timeout_s", c.hw_bridge.command_timeout_s}};
+  for (const auto& [key, gap_s] : tolerated_gaps_s) {
+    if (!(window_s > gap_s)) {
+      throw ConfigError("lcm.time_window_s",
+                        Fmt(window_s) + " s must exceed " + key + " (" + Fmt(gap_s) + " s)");
     }
   }
   if (c.safety.leg_stroke.enabled) {

@@ -30,7 +30,8 @@ ControllerNode::ControllerNode(const StackConfig& config, lcm::LCM* lcm,
       lcm_(lcm),
       receiver_(config.lcm.url),
       health_("controller", config.lcm.channels.health, config.lcm.health_rate_hz),
-      process_(config.platform, config.controller, config.home_pose, std::move(scenario), &health_),
+      process_(config.platform, config.controller, config.home_pose, std::move(scenario), &health_,
+               config.lcm.time_plausibility),
       auth_(MessageAuthenticator::FromKeyFile(config.lcm.auth_key_file)),
       exit_at_end_(exit_at_end) {
   if (restart_scenario) process_.RestartScenario();
@@ -59,9 +60,13 @@ void ControllerNode::OnSupervisor(const lcm::ReceiveBuffer*, const std::string&,
   process_.OnSupervisor(msg->utime, msg->motion_time_us, running);
 }
 
-void ControllerNode::OnState(const lcm::ReceiveBuffer*, const std::string&, const state_t* msg) {
+void ControllerNode::OnState(const lcm::ReceiveBuffer* rbuf, const std::string&,
+                             const state_t* msg) {
   ControllerProcessOutput out;
-  if (process_.OnState(FromMessage(*msg), &out) != ControllerVerdict::kPublished) return;
+  if (process_.OnState(FromMessage(*msg), &out, rbuf->recv_utime) !=
+      ControllerVerdict::kPublished) {
+    return;
+  }
   ToMessage(out.command, &command_);
   lcm_->publish(config_.lcm.channels.command_nominal, &command_);
   if (out.has_setpoint_echo) {

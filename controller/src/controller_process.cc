@@ -9,8 +9,10 @@ namespace stewart {
 
 ControllerProcess::ControllerProcess(const PlatformParams& platform, const ControllerConfig& gains,
                                      const Vector6d& home_pose, std::optional<Scenario> scenario,
-                                     HealthCounters* counters)
-    : controller_(platform, gains, home_pose, std::move(scenario)), counters_(counters) {
+                                     HealthCounters* counters, const TimePlausibilityParams& time)
+    : controller_(platform, gains, home_pose, std::move(scenario)),
+      counters_(counters),
+      time_check_(time, "state", gains.stale_age_s, counters) {
   STEWART_CHECK(counters_ != nullptr, "ControllerProcess needs its counters");
 }
 
@@ -25,16 +27,28 @@ void ControllerProcess::OnSupervisor(int64_t utime, int64_t motion_time_us, bool
   controller_.SetMotionClock(utime, motion_time_us, running);
 }
 
-ControllerVerdict ControllerProcess::OnState(const StateSample& state,
-                                             ControllerProcessOutput* out) {
+ControllerVerdict ControllerProcess::OnState(const StateSample& state, ControllerProcessOutput* out,
+                                             std::optional<int64_t> receive_wall_us) {
   counters_->CountIn();
+  // Before the control law: the scenario clock starts at the first state
+  // and a state far ahead would put every later one out of order.
+  if (!time_check_.CheckSource(state.utime, state.sample_utime, receive_wall_us)) {
+    return ControllerVerdict::kTimeImplausible;
+  }
   if (!StateUsable(state)) {
+    // A real state (the estimator initialising): its time is the stack's.
+    time_check_.SourceAccepted(state.utime, receive_wall_us);
     counters_->Reject("state_not_valid", "status " + std::to_string(state.status));
     return ControllerVerdict::kStateNotUsable;
   }
   ControllerOutput step;
   const StepStatus status =
       controller_.Step(state.utime, state.q, state.qd, state.disturbance, &step);
+  if (status == StepStatus::kTimeNotIncreasing) {
+    time_check_.SourceRejected(state.utime, receive_wall_us);
+  } else {
+    time_check_.SourceAccepted(state.utime, receive_wall_us);
+  }
   if (status != StepStatus::kOk) {
     counters_->Reject(ToString(status));
     return ControllerVerdict::kStepRejected;

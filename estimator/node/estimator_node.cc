@@ -14,7 +14,7 @@ EstimatorNode::EstimatorNode(const StackConfig& config, lcm::LCM* lcm, bool perf
       receiver_(config.lcm.url),
       health_("estimator", config.lcm.channels.health, config.lcm.health_rate_hz),
       process_(config.platform, config.actuators, config.sensors, config.estimator,
-               config.home_pose, &health_) {
+               config.home_pose, &health_, config.lcm.time_plausibility) {
   if (perfect_state) {
     spdlog::warn("estimator: PERFECT STATE mode: republishing {} as {} (testing only)",
                  config_.lcm.channels.state_truth, config_.lcm.channels.state_estimate);
@@ -25,20 +25,22 @@ EstimatorNode::EstimatorNode(const StackConfig& config, lcm::LCM* lcm, bool perf
   }
 }
 
-void EstimatorNode::OnCommand(const lcm::ReceiveBuffer*, const std::string&,
+void EstimatorNode::OnCommand(const lcm::ReceiveBuffer* rbuf, const std::string&,
                               const force_command_t* msg) {
-  process_.OnCommand(FromMessage(*msg));
+  process_.OnCommand(FromMessage(*msg), rbuf->recv_utime);
 }
 
-void EstimatorNode::OnSensor(const lcm::ReceiveBuffer*, const std::string&, const sensor_t* msg) {
+void EstimatorNode::OnSensor(const lcm::ReceiveBuffer* rbuf, const std::string&,
+                             const sensor_t* msg) {
   StateSample state;
-  if (process_.OnSensor(SampleFromMessage(*msg), &state)) Publish(state);
+  if (process_.OnSensor(SampleFromMessage(*msg), &state, rbuf->recv_utime)) Publish(state);
   health_.MaybePublish(lcm_);
 }
 
-void EstimatorNode::OnTruth(const lcm::ReceiveBuffer*, const std::string&, const state_t* msg) {
+void EstimatorNode::OnTruth(const lcm::ReceiveBuffer* rbuf, const std::string&,
+                            const state_t* msg) {
   StateSample state;
-  if (process_.OnTruth(FromMessage(*msg), &state)) Publish(state);
+  if (process_.OnTruth(FromMessage(*msg), &state, rbuf->recv_utime)) Publish(state);
   health_.MaybePublish(lcm_);
 }
 

@@ -22,13 +22,23 @@ StateSample StateFromEstimate(const Estimate& estimate, int64_t seq) {
 
 EstimatorProcess::EstimatorProcess(const PlatformParams& platform, const ActuatorConfig& actuators,
                                    const SensorConfig& sensors, const EstimatorConfig& estimator,
-                                   const Vector6d& home_pose, HealthCounters* counters)
-    : ekf_(platform, actuators, sensors, estimator, home_pose), counters_(counters) {
+                                   const Vector6d& home_pose, HealthCounters* counters,
+                                   const TimePlausibilityParams& time)
+    : ekf_(platform, actuators, sensors, estimator, home_pose),
+      counters_(counters),
+      time_check_(time, estimator.perfect_state ? "truth" : "sensor", estimator.max_dt_s,
+                  counters) {
   STEWART_CHECK(counters_ != nullptr, "EstimatorProcess needs its counters");
 }
 
-void EstimatorProcess::OnCommand(const ForceCommand& command) {
+void EstimatorProcess::OnCommand(const ForceCommand& command,
+                                 std::optional<int64_t> receive_wall_us) {
   counters_->CountIn();
+  // A command's sample_utime is the sample it answers: the EKF files it
+  // under that time, so a far-off one would act on every later prediction.
+  if (!time_check_.CheckOther("command", command.utime, command.sample_utime, receive_wall_us)) {
+    return;
+  }
   if (!command.force_n.allFinite()) {
     counters_->Reject("command_non_finite");
     return;
@@ -37,9 +47,18 @@ void EstimatorProcess::OnCommand(const ForceCommand& command) {
                        (command.flags & kCommandDriveOff) != 0);
 }
 
-bool EstimatorProcess::OnSensor(const SensorSample& sample, StateSample* out) {
+bool EstimatorProcess::OnSensor(const SensorSample& sample, StateSample* out,
+                                std::optional<int64_t> receive_wall_us) {
   counters_->CountIn();
+  // Before the EKF: a sample far ahead would restart it at that time (a gap
+  // over max_dt_s) and every real sample after it would be out of order.
+  if (!time_check_.CheckSource(sample.utime, sample.utime, receive_wall_us)) return false;
   const UpdateResult result = ekf_.Update(sample);
+  if (result.Has(kRejectTime)) {
+    time_check_.SourceRejected(sample.utime, receive_wall_us);
+  } else {
+    time_check_.SourceAccepted(sample.utime, receive_wall_us);
+  }
   for (uint32_t bit = 1; bit <= kEventLast; bit <<= 1) {
     if (!(result.events & bit)) continue;
     const auto event = static_cast<EkfEvent>(bit);
@@ -60,12 +79,15 @@ bool EstimatorProcess::OnSensor(const SensorSample& sample, StateSample* out) {
   return Emit(StateFromEstimate(estimate, seq_), out);
 }
 
-bool EstimatorProcess::OnTruth(const StateSample& truth, StateSample* out) {
+bool EstimatorProcess::OnTruth(const StateSample& truth, StateSample* out,
+                               std::optional<int64_t> receive_wall_us) {
   counters_->CountIn();
+  if (!time_check_.CheckSource(truth.utime, truth.sample_utime, receive_wall_us)) return false;
   if (!truth.q.allFinite() || !truth.qd.allFinite()) {
     counters_->Reject("truth_non_finite");
     return false;
   }
+  time_check_.SourceAccepted(truth.utime, receive_wall_us);
   StateSample state = truth;
   state.seq = seq_;
   state.status = kStateValid | kStatePerfectState;

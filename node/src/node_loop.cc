@@ -2,6 +2,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include "stewart/node/operator_reset.h"
 #include "stewart/node/stop_signal.h"
 
 namespace stewart {
@@ -12,7 +13,9 @@ void ReportReceiverCounters(const LcmReceiver& receiver, HealthReporter* health)
 }
 
 ExitCode RunNodeLoop(const std::string& name, lcm::LCM* lcm, LcmReceiver* receiver,
-                HealthReporter* health, int poll_ms, const std::function<bool()>& done) {
+                     HealthReporter* health, int poll_ms, const std::function<bool()>& done) {
+  // The operator's RESETs come through this receiver: no socket of their own.
+  AttachOperatorResets(receiver);
   health->MaybePublish(lcm, true);
   while (!StopRequested()) {
     if (receiver->HandleTimeout(poll_ms) < 0 && !StopRequested()) {

@@ -9,6 +9,7 @@
 #include "stewart/config/config_loader.h"
 #include "stewart/node/lcm_handle.h"
 #include "stewart/node/node_options.h"
+#include "stewart/node/operator_reset.h"
 #include "stewart/node/stop_signal.h"
 
 namespace stewart {
@@ -44,7 +45,11 @@ int NodeMain(int argc, char** argv, const NodeInfo& info, const AddFlagsFn& add_
   InstallStopSignalHandlers();
   try {
     std::unique_ptr<lcm::LCM> lcm;
-    if (info.needs_lcm || !config.lcm.url.empty()) lcm = MakeLcm(config.lcm.url);
+    if (info.needs_lcm || !config.lcm.url.empty()) {
+      lcm = MakeLcm(config.lcm.url);
+      // Every heartbeat of this process takes the operator's RESETs from it.
+      InstallOperatorResetListener(config.lcm);
+    }
     return ToInt(run(config, lcm.get()));
   } catch (const InputError& e) {
     spdlog::error("{}: {}", info.name, e.what());

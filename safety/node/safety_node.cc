@@ -41,7 +41,7 @@ SafetyNode::SafetyNode(const StackConfig& config, lcm::LCM* lcm,
       receiver_(config.lcm.url),
       health_("safety", config.lcm.channels.health, config.lcm.health_rate_hz),
       process_(config.platform, config.safety, config.actuators, config.supervisor, reference,
-               &health_),
+               &health_, config.lcm.time_plausibility),
       auth_(MessageAuthenticator::FromKeyFile(config.lcm.auth_key_file)),
       monitor_(config.supervisor.required_processes,
                std::llround(config.supervisor.heartbeat_timeout_s * 1e6)),
@@ -53,15 +53,15 @@ SafetyNode::SafetyNode(const StackConfig& config, lcm::LCM* lcm,
   last_operator_wall_us_ = WallUs();
 }
 
-void SafetyNode::OnState(const lcm::ReceiveBuffer*, const std::string&, const state_t* msg) {
+void SafetyNode::OnState(const lcm::ReceiveBuffer* rbuf, const std::string&, const state_t* msg) {
   safety::SafetyOutput out;
-  if (process_.OnState(FromMessage(*msg), &out)) Publish(out);
+  if (process_.OnState(FromMessage(*msg), &out, rbuf->recv_utime)) Publish(out);
 }
 
-void SafetyNode::OnNominal(const lcm::ReceiveBuffer*, const std::string&,
+void SafetyNode::OnNominal(const lcm::ReceiveBuffer* rbuf, const std::string&,
                            const force_command_t* msg) {
   safety::SafetyOutput out;
-  if (process_.OnNominal(FromMessage(*msg), &out)) Publish(out);
+  if (process_.OnNominal(FromMessage(*msg), &out, rbuf->recv_utime)) Publish(out);
 }
 
 void SafetyNode::OnOperator(const lcm::ReceiveBuffer*, const std::string&,

@@ -15,11 +15,13 @@ bool StateFinite(const StateSample& s) {
 
 SafetyProcess::SafetyProcess(const PlatformParams& platform, const SafetyConfig& safety,
                              const ActuatorConfig& actuators, const SupervisorConfig& supervisor,
-                             ReferenceQpSolver* reference, HealthCounters* counters)
+                             ReferenceQpSolver* reference, HealthCounters* counters,
+                             const TimePlausibilityParams& time)
     : filter_(platform, safety, actuators, reference),
       supervisor_(supervisor),
       counters_(counters),
-      stale_age_us_(static_cast<int64_t>(safety.stale_age_s * 1e6)) {
+      stale_age_us_(static_cast<int64_t>(safety.stale_age_s * 1e6)),
+      time_check_(time, "state", safety.stale_age_s, counters) {
   STEWART_CHECK(counters_ != nullptr, "SafetyProcess needs its counters");
   counters_->SetCounter("fallback_commands", 0);
   counters_->SetCounter("active_steps", 0);
@@ -39,16 +41,22 @@ const StateSample* SafetyProcess::FindState(int64_t sample_utime) const {
   return nullptr;
 }
 
-bool SafetyProcess::OnState(const StateSample& state, SafetyOutput* out) {
+bool SafetyProcess::OnState(const StateSample& state, SafetyOutput* out,
+                            std::optional<int64_t> receive_wall_us) {
   counters_->CountIn();
   if (!StateFinite(state)) {
     counters_->Reject("nonfinite_state");
     return false;
   }
+  // Before it can become the newest state: one far ahead would put every
+  // real state after it out of order, and be answered with its own time.
+  if (!time_check_.CheckSource(state.utime, state.sample_utime, receive_wall_us)) return false;
   if (state.utime <= newest_state_utime_) {
     counters_->Reject("state_time_not_increasing");
+    time_check_.SourceRejected(state.utime, receive_wall_us);
     return false;
   }
+  time_check_.SourceAccepted(state.utime, receive_wall_us);
   states_[static_cast<size_t>(states_next_)] = state;
   states_next_ = (states_next_ + 1) % kStateHistory;
   states_count_ = std::min(states_count_ + 1, kStateHistory);
@@ -79,8 +87,12 @@ bool SafetyProcess::OnState(const StateSample& state, SafetyOutput* out) {
   // the next states (else whether the answer beat the next state over
   // multicast would decide between filter and fallback).
   if (first_usable_state_utime_ < 0) first_usable_state_utime_ = state.utime;
-  const int64_t newest_earlier_nominal =
-      pending_for_this ? newest_nominal_before_pending_ : newest_nominal_sample_utime_;
+  const int64_t newest_earlier_nominal = newest_nominal_sample_utime_;
+  // The pending nominal's state has come: from now on it shows the
+  // controller alive.
+  if (pending_for_this) {
+    newest_nominal_sample_utime_ = std::max(newest_nominal_sample_utime_, state.sample_utime);
+  }
   if (state.utime - std::max(newest_earlier_nominal, first_usable_state_utime_) > stale_age_us_) {
     if (state.sample_utime <= last_published_sample_utime_) return false;
     *out = Fallback(state, kCommandStaleInput);
@@ -94,12 +106,20 @@ bool SafetyProcess::OnState(const StateSample& state, SafetyOutput* out) {
   return false;
 }
 
-bool SafetyProcess::OnNominal(const ForceCommand& nominal, SafetyOutput* out) {
+bool SafetyProcess::OnNominal(const ForceCommand& nominal, SafetyOutput* out,
+                              std::optional<int64_t> receive_wall_us) {
   counters_->CountIn();
+  // Against the states' time: a nominal far ahead would otherwise hold the
+  // watchdog off until the states caught up with it.
+  if (!time_check_.CheckOther("nominal", nominal.utime, nominal.sample_utime, receive_wall_us)) {
+    return false;
+  }
   // A command that arrives, even one answered already by a fallback, shows
-  // the controller is alive.
-  const int64_t newest_nominal_before = newest_nominal_sample_utime_;
-  newest_nominal_sample_utime_ = std::max(newest_nominal_sample_utime_, nominal.sample_utime);
+  // the controller is alive; one ahead of every state only once its state
+  // arrives (OnState).
+  if (nominal.sample_utime <= newest_state_utime_) {
+    newest_nominal_sample_utime_ = std::max(newest_nominal_sample_utime_, nominal.sample_utime);
+  }
   if (nominal.sample_utime <= last_published_sample_utime_) {
     counters_->Reject("nominal_already_answered");  // a fallback went out for it
     return false;
@@ -112,7 +132,6 @@ bool SafetyProcess::OnNominal(const ForceCommand& nominal, SafetyOutput* out) {
       // that state arrives (OnState), never filtered against another state.
       pending_nominal_ = nominal;
       has_pending_nominal_ = true;
-      newest_nominal_before_pending_ = newest_nominal_before;
       counters_->Count("nominal_before_state");
       return false;
     }

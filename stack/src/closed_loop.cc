@@ -82,15 +82,15 @@ ClosedLoopSummary RunClosedLoop(const StackConfig& config, const Scenario& scena
   HealthCounters estimator_counters("estimator"), controller_counters("controller"),
       safety_counters("safety");
   EstimatorProcess estimator(config.platform, config.actuators, sensors, config.estimator,
-                             config.home_pose, &estimator_counters);
+                             config.home_pose, &estimator_counters, config.lcm.time_plausibility);
   ControllerProcess controller(config.platform, config.controller, config.home_pose, scenario,
-                               &controller_counters);
+                               &controller_counters, config.lcm.time_plausibility);
   // A simulation: the supervisor arms by itself, as tools/launch.sh has it
   // do in simulation (no operator in the loop).
   safety::SupervisorConfig supervisor = config.supervisor;
   supervisor.auto_arm = true;
   safety::SafetyProcess safety(config.platform, config.safety, config.actuators, supervisor,
-                               options.reference, &safety_counters);
+                               options.reference, &safety_counters, config.lcm.time_plausibility);
 
   const std::int64_t period_us = std::llround(1e6 / sensors.rate_hz);
   const long ticks = std::lround(options.duration_s * 1e6 / static_cast<double>(period_us));

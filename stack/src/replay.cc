@@ -15,6 +15,7 @@
 #include "stewart/node/eigen_msg.h"
 #include "stewart/node/signal_messages.h"
 #include "stewart/safety/diagnostics_lcm.h"
+#include "stewart/safety/process_monitor.h"
 #include "stewart/safety/safety_process.h"
 #include "stewart/safety_diagnostics_t.hpp"
 
@@ -81,6 +82,12 @@ std::optional<Stamp> WithMessages(RecordedLog* log, Channel channel, F f) {
       return f(&log->nominal);
     case Channel::kCommandSafe:
       return f(&log->safe);
+    case Channel::kSupervisor:
+      return f(&log->supervisor);
+    case Channel::kOperator:
+      return f(&log->operator_commands);
+    case Channel::kHealth:
+      return f(&log->health);
     case Channel::kSafetyDiagnostics:
       break;
   }
@@ -138,6 +145,9 @@ RecordedLog ReadLog(const std::string& path, const ChannelNames& channels) {
       {channels.command_nominal, Channel::kCommandNominal},
       {channels.command_safe, Channel::kCommandSafe},
       {channels.safety_diagnostics, Channel::kSafetyDiagnostics},
+      {channels.supervisor, Channel::kSupervisor},
+      {channels.operator_command, Channel::kOperator},
+      {channels.health, Channel::kHealth},
   };
   RecordedLog log;
   for (const auto& [name, channel] : routes) log.channel_names[static_cast<size_t>(channel)] = name;
@@ -185,7 +195,12 @@ RecordedLog ReadLog(const std::string& path, const ChannelNames& channels) {
     }
     if (stamp) {
       log.order.emplace_back(channel, index);
-      track(channel, stamp->first, stamp->second);
+      log.order_timestamp_us.push_back(event->timestamp);
+      // Operator commands (seq per console) and heartbeats (seq per
+      // process) share their channel between publishers: no gaps to find.
+      if (channel != Channel::kOperator && channel != Channel::kHealth) {
+        track(channel, stamp->first, stamp->second);
+      }
     } else {
       ++log.undecodable[event->channel];
     }
@@ -240,8 +255,10 @@ SafetyReplayResult ReplaySafety(const StackConfig& config, const RecordedLog& lo
   SafetyReplayResult r;
   // The process's own class, built exactly as the live node built it.
   HealthCounters counters("safety replay");
+  // No receive times: the time checks judge message times only, so a log
+  // replays to the same outputs whenever and however fast it is replayed.
   safety::SafetyProcess process(config.platform, config.safety, config.actuators, config.supervisor,
-                                reference, &counters);
+                                reference, &counters, config.lcm.time_plausibility);
   const safety::SafetyFilter& filter = process.filter();
   r.variant = filter.variant();
   if (r.variant == SafetyVariant::kQpReference && reference != nullptr) {
@@ -347,7 +364,35 @@ SafetyReplayResult ReplaySafety(const StackConfig& config, const RecordedLog& lo
     return log.nominal[nominal_next].seq > expected;
   };
   r.steps.reserve(log.nominal.size());
-  for (const auto& [channel, index] : log.order) {
+  // What the live supervisor heard besides states and nominal commands:
+  // the operator's commands and the heartbeats, in log order (heartbeat
+  // silence judged on the logger's receive times, an approximation of the
+  // live process's clock).
+  safety::ProcessMonitor monitor(config.supervisor.required_processes,
+                                 std::llround(config.supervisor.heartbeat_timeout_s * 1e6));
+  for (size_t e = 0; e < log.order.size(); ++e) {
+    const auto& [channel, index] = log.order[e];
+    const int64_t timestamp_us = log.order_timestamp_us[e];
+    for (const std::string& fault : monitor.CheckSilence(timestamp_us)) {
+      process.supervisor().OnFault(fault);
+    }
+    if (channel == Channel::kOperator) {
+      const operator_command_t& op = log.operator_commands[static_cast<size_t>(index)];
+      if (op.command >= static_cast<int8_t>(safety::OperatorCommand::kArm) &&
+          op.command <= static_cast<int8_t>(safety::OperatorCommand::kHeartbeat)) {
+        std::string why_not;
+        const bool healthy = monitor.Healthy(timestamp_us, &why_not);
+        process.supervisor().OnOperator(static_cast<safety::OperatorCommand>(op.command), healthy,
+                                        why_not, nullptr);
+      }
+      continue;
+    }
+    if (channel == Channel::kHealth) {
+      const health_t& h = log.health[static_cast<size_t>(index)];
+      const std::string fault = monitor.OnHeartbeat(h.name, h.state, h.seq, timestamp_us);
+      if (!fault.empty()) process.supervisor().OnFault(fault);
+      continue;
+    }
     safety::SafetyOutput out;
     if (channel == Channel::kStateEstimate) {
       ++r.states;
@@ -403,13 +448,23 @@ ControllerReplayResult ReplayController(const StackConfig& config, const Scenari
   r.scenario = scenario.name();
   HealthCounters counters("controller replay");
   ControllerProcess process(config.platform, config.controller, config.home_pose, scenario,
-                            &counters);
+                            &counters, config.lcm.time_plausibility);
   Pairing<force_command_t> recorded_commands(log.nominal, &r.commands);
   const std::optional<int64_t> origin = ControllerTimeOrigin(log, &r.time_origin_inferred);
   r.time_origin_utime = origin.value_or(-1);
   bool started = false;
-  // The process's OnState, per recorded estimate in log order.
-  for (const state_t& state_msg : log.estimates) {
+  // The process's OnState per recorded estimate, and its OnSupervisor per
+  // recorded supervisor state (the motion clock), in log order.
+  for (const auto& [channel, index] : log.order) {
+    if (channel == Channel::kSupervisor) {
+      const supervisor_state_t& sup = log.supervisor[static_cast<size_t>(index)];
+      process.OnSupervisor(sup.utime, sup.motion_time_us,
+                           sup.state == supervisor_state_t::STATE_ARMING ||
+                               sup.state == supervisor_state_t::STATE_ARMED);
+      continue;
+    }
+    if (channel != Channel::kStateEstimate) continue;
+    const state_t& state_msg = log.estimates[static_cast<size_t>(index)];
     ++r.states;
     const StateSample state = FromMessage(state_msg);
     ControllerProcessOutput out;
@@ -426,7 +481,8 @@ ControllerReplayResult ReplayController(const StackConfig& config, const Scenari
       continue;
     }
     started = true;
-    if (verdict == ControllerVerdict::kStepRejected) {
+    if (verdict == ControllerVerdict::kStepRejected ||
+        verdict == ControllerVerdict::kTimeImplausible) {
       ++r.step_rejected;
       continue;
     }
@@ -502,7 +558,7 @@ EstimatorReplayResult ReplayEstimator(const StackConfig& config, const RecordedL
   Pairing<state_t> recorded_estimates(log.estimates, &r.estimates);
   HealthCounters counters("estimator replay");
   EstimatorProcess process(config.platform, config.actuators, config.sensors, config.estimator,
-                           config.home_pose, &counters);
+                           config.home_pose, &counters, config.lcm.time_plausibility);
   auto compare = [&](const StateSample& sample) {
     state_t replayed{};
     ToMessage(sample, &replayed);

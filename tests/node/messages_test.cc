@@ -94,9 +94,19 @@ TEST(Messages, VariableLengthDiagnosticsAndHealth) {
   h.num_counters = 1;
   h.counter_names = {"rejected_nan"};
   h.counter_values = {3};
+  h.counter_deltas = {2};
+  h.worst_state = health_t::STATE_FAULT;
+  h.fault_latched = true;
+  h.latched_error = "every state rejected";
+  h.rejected_inputs_delta = 5;
   const health_t h2 = RoundTrip(h);
   EXPECT_EQ(h2.name, "estimator");
   EXPECT_EQ(h2.counter_values[0], 3);
+  EXPECT_EQ(h2.counter_deltas[0], 2);
+  EXPECT_EQ(h2.worst_state, +health_t::STATE_FAULT);
+  EXPECT_TRUE(h2.fault_latched);
+  EXPECT_EQ(h2.latched_error, "every state rejected");
+  EXPECT_EQ(h2.rejected_inputs_delta, 5);
 }
 
 }  // namespace

@@ -96,6 +96,8 @@ int main(int argc, char** argv) {
     health.num_counters = 1;
     health.counter_names = {"rounds"};
     health.counter_values = {k};
+    health.counter_deltas = {1};
+    health.worst_state = stewart::health_t::STATE_OK;
     lcm->publish(ch.health, &health);
     usleep(static_cast<useconds_t>(period_ms) * 1000);
   }

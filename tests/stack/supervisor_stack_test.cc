@@ -5,7 +5,7 @@
 // restarted controller leaves it held (no automatic resume), `resume` is
 // refused until `reset`, then ramps back to the filtered command with the
 // scenario's clock where it was; `estop` turns the drive off and latches.
-// LCM port 7827 (this folder owns 7820-7829).
+// LCM ports 7827 and 7828 (this folder owns 7820-7829).
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <stdio.h>
@@ -117,9 +117,34 @@ TEST(SupervisorStack, ArmHoldAfterARestartResumeAndEstopWithTheConsole) {
   EXPECT_GT(motion_before_us, 1'500'000);
 
   // The controller dies and comes back: held, and it stays held.
+  const size_t n_states = sink.supervisor.size();
   controller->Stop(SIGKILL);
   pump_for(0.5);
   EXPECT_EQ(last_state(), int8_t{supervisor_state_t::STATE_HOLD});
+  {
+    // Fault to hold, in stack time: the last filtered command, then the
+    // watchdog's fallbacks for supervisor.fallback_latch_s, then HOLD.
+    int64_t last_filtered = -1;
+    for (const force_command_t& c : sink.safe) {
+      if (!Fallback(c)) last_filtered = std::max(last_filtered, c.sample_utime);
+    }
+    int64_t hold_utime = -1;
+    for (size_t i = n_states; i < sink.supervisor.size() && hold_utime < 0; ++i) {
+      if (sink.supervisor[i].state == supervisor_state_t::STATE_HOLD) {
+        hold_utime = sink.supervisor[i].utime;
+      }
+    }
+    ASSERT_GT(last_filtered, 0);
+    ASSERT_GT(hold_utime, 0);
+    const double ms = 1e-3 * static_cast<double>(hold_utime - last_filtered);
+    const double bound_ms =
+        1e3 * (config.safety.stale_age_s + config.supervisor.fallback_latch_s) + 2.0;
+    EXPECT_LE(ms, bound_ms);
+    std::printf(
+        "[supervisor] controller killed: HOLD %.1f ms (stack time) after the last "
+        "filtered command (bound %.1f ms)\n",
+        ms, bound_ms);
+  }
   controller = std::make_unique<test::ChildProcess>(with({CONTROLLER_PATH, "--scenario", "paper"}));
   ASSERT_TRUE(controller->started());
   pump_for(2.0);
@@ -159,6 +184,61 @@ TEST(SupervisorStack, ArmHoldAfterARestartResumeAndEstopWithTheConsole) {
   pump_for(0.3);
   EXPECT_EQ(sink.supervisor.back().state, int8_t{supervisor_state_t::STATE_DISARMED});
   EXPECT_GE(sink.supervisor.back().operator_commands_rejected, 1);
+}
+
+// The dead-man: with supervisor.operator_timeout_s set, an armed platform
+// holds when the operator's console stops sending heartbeats.
+TEST(SupervisorStack, TheDeadManHoldsWhenTheOperatorsHeartbeatsStop) {
+  const StackConfig config = LoadStackConfig(DefaultConfigPath());
+  const std::string url = PrivateLcmUrl(kPort + 1);
+  const std::string overlay = ::testing::TempDir() + "supervisor_deadman_overlay.yaml";
+  std::ofstream(overlay) << "supervisor:\n  arming_ramp_s: 0.2\n  operator_timeout_s: 0.5\n";
+  auto lcm = MakeLcm(url);
+  Sink sink;
+  lcm->subscribe(config.lcm.channels.supervisor, &Sink::OnSupervisor, &sink)
+      ->setQueueCapacity(100000);
+  const std::vector<std::string> common = {"--lcm-url", url,           "--overlay",
+                                           overlay,     "--log-level", "warn"};
+  auto with = [&](std::vector<std::string> head) {
+    head.insert(head.end(), common.begin(), common.end());
+    return head;
+  };
+  const std::string ctl_common = "--lcm-url '" + url + "' --overlay " + overlay;
+  test::ChildProcess safety(with({SAFETY_PATH}));
+  test::ChildProcess controller(with({CONTROLLER_PATH, "--scenario", "paper"}));
+  test::ChildProcess estimator(with({ESTIMATOR_PATH}));
+  test::ChildProcess plant(with({PLANT_SIM_PATH, "--mode", "realtime"}));
+  ASSERT_TRUE(safety.started() && controller.started() && estimator.started() && plant.started());
+  auto pump_for = [&](double seconds) {
+    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+    while (std::chrono::steady_clock::now() < end) lcm->handleTimeout(10);
+  };
+  pump_for(1.5);
+  // A console that keeps the dead-man fed, then the arm.
+  auto console = std::make_unique<test::ChildProcess>(
+      std::vector<std::string>{STEWART_CTL_PATH, "heartbeat", "--period", "0.1", "--lcm-url", url,
+                               "--overlay", overlay, "--log-level", "warn"});
+  ASSERT_TRUE(console->started());
+  pump_for(0.3);
+  ASSERT_EQ(Ctl("arm " + ctl_common).exit_code, 0);
+  pump_for(1.5);
+  ASSERT_FALSE(sink.supervisor.empty());
+  EXPECT_EQ(sink.supervisor.back().state, int8_t{supervisor_state_t::STATE_ARMED});
+  // The console goes away: held within the timeout (plus a poll).
+  console->Stop(SIGKILL);
+  const auto killed = std::chrono::steady_clock::now();
+  bool held = false;
+  while (!held && std::chrono::steady_clock::now() - killed < std::chrono::seconds(2)) {
+    lcm->handleTimeout(10);
+    held = sink.supervisor.back().state == supervisor_state_t::STATE_HOLD;
+  }
+  const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - killed).count();
+  ASSERT_TRUE(held) << "still " << int{sink.supervisor.back().state} << " after 2 s";
+  EXPECT_GE(s, 0.35);
+  EXPECT_LE(s, 1.0);
+  EXPECT_NE(sink.supervisor.back().reason.find("dead-man"), std::string::npos)
+      << sink.supervisor.back().reason;
+  std::printf("[supervisor] dead-man: HOLD %.2f s after the last heartbeat source died\n", s);
 }
 
 }  // namespace

@@ -6,10 +6,12 @@
 
 #include "stewart/force_command_t.hpp"
 #include "stewart/health_t.hpp"
+#include "stewart/operator_command_t.hpp"
 #include "stewart/safety_diagnostics_t.hpp"
 #include "stewart/sensor_t.hpp"
 #include "stewart/setpoint_t.hpp"
 #include "stewart/state_t.hpp"
+#include "stewart/supervisor_state_t.hpp"
 
 namespace stewart {
 namespace {
@@ -165,21 +167,54 @@ class DiagnosticsWriter : public TypedWriter<safety_diagnostics_t> {
   }
 };
 
+/// Free text inside a quoted CSV field: no quote, no line break.
+std::string Quotable(std::string text) {
+  for (char& c : text) {
+    if (c == '"' || c == '\n') c = '\'';
+  }
+  return text;
+}
+
 class HealthWriter : public TypedWriter<health_t> {
   std::string Columns() const override {
-    return ",name,state,messages_in,messages_out,rejected_inputs,counters,last_error";
+    return ",name,state,worst_state,fault_latched,messages_in,messages_out,rejected_inputs,"
+           "period_us,messages_in_delta,messages_out_delta,rejected_inputs_delta,counters,"
+           "counter_deltas,last_error,latched_error";
   }
   void Row(const health_t& m, std::ostream& out) const override {
-    out << ',' << m.name << ',' << int{m.state} << ',' << m.messages_in << ',' << m.messages_out
-        << ',' << m.rejected_inputs << ",\"";
+    out << ',' << m.name << ',' << int{m.state} << ',' << int{m.worst_state} << ','
+        << int{m.fault_latched} << ',' << m.messages_in << ',' << m.messages_out << ','
+        << m.rejected_inputs << ',' << m.period_us << ',' << m.messages_in_delta << ','
+        << m.messages_out_delta << ',' << m.rejected_inputs_delta << ",\"";
     for (std::size_t i = 0; i < m.counter_names.size(); ++i) {
       out << (i ? ";" : "") << m.counter_names[i] << '=' << m.counter_values[i];
     }
-    std::string error = m.last_error;
-    for (char& c : error) {
-      if (c == '"' || c == '\n') c = '\'';
+    out << "\",\"";
+    for (std::size_t i = 0; i < m.counter_names.size(); ++i) {
+      out << (i ? ";" : "") << m.counter_names[i] << '=' << m.counter_deltas[i];
     }
-    out << "\",\"" << error << '"';
+    out << "\",\"" << Quotable(m.last_error) << "\",\"" << Quotable(m.latched_error) << '"';
+  }
+};
+
+class SupervisorWriter : public TypedWriter<supervisor_state_t> {
+  std::string Columns() const override {
+    return ",session_id,state,arming_progress,motion_time_us,transitions,"
+           "operator_commands_accepted,operator_commands_rejected,fault_latched,reason,"
+           "last_operator_reply";
+  }
+  void Row(const supervisor_state_t& m, std::ostream& out) const override {
+    out << ',' << m.session_id << ',' << int{m.state} << ',' << m.arming_progress << ','
+        << m.motion_time_us << ',' << m.transitions << ',' << m.operator_commands_accepted << ','
+        << m.operator_commands_rejected << ',' << int{m.fault_latched} << ",\""
+        << Quotable(m.reason) << "\",\"" << Quotable(m.last_operator_reply) << '"';
+  }
+};
+
+class OperatorWriter : public TypedWriter<operator_command_t> {
+  std::string Columns() const override { return ",operator_id,command,note"; }
+  void Row(const operator_command_t& m, std::ostream& out) const override {
+    out << ',' << m.operator_id << ',' << int{m.command} << ",\"" << Quotable(m.note) << '"';
   }
 };
 
@@ -200,6 +235,8 @@ const CsvChannelWriter* FindCsvWriter(const void* data, int size) {
   static const ForceCommandWriter command;
   static const DiagnosticsWriter diagnostics;
   static const HealthWriter health;
+  static const SupervisorWriter supervisor;
+  static const OperatorWriter operator_command;
   const int64_t hash = PayloadHash(data, size);
   if (hash == sensor_t::getHash()) return &sensor;
   if (hash == state_t::getHash()) return &state;
@@ -207,6 +244,8 @@ const CsvChannelWriter* FindCsvWriter(const void* data, int size) {
   if (hash == force_command_t::getHash()) return &command;
   if (hash == safety_diagnostics_t::getHash()) return &diagnostics;
   if (hash == health_t::getHash()) return &health;
+  if (hash == supervisor_state_t::getHash()) return &supervisor;
+  if (hash == operator_command_t::getHash()) return &operator_command;
   return nullptr;
 }
 

@@ -34,7 +34,82 @@ def load(run, channel_key, config):
     if not rows:
         return None
     return {k: np.array([float(r[k]) for r in rows]) for k in rows[0]
-            if k not in ("name", "counters", "last_error")}
+            if k not in ("name", "counters", "counter_deltas", "last_error", "latched_error")}
+
+
+SEVERITY = {2: 1, 3: 2}  # DEGRADED, FAULT; the other states are no problem
+
+
+def health_section(run, config):
+    """Per process, from all its heartbeats: the worst state during the run (each heartbeat
+    carries the worst since the previous one), whether a fault latched, and its rejections."""
+    lcm = config["lcm"]
+    name = lcm["channel_prefix"] + lcm["channels"]["health"] + (lcm.get("channel_suffix") or "")
+    path = os.path.join(run, "csv", name + ".csv")
+    if not os.path.exists(path):
+        return []
+    rows = {}
+    with open(path) as f:
+        for row in csv.DictReader(f):
+            rows.setdefault(row["name"], []).append(row)
+    if not rows or "worst_state" not in next(iter(rows.values()))[0]:
+        return []  # recorded before heartbeats carried the worst state
+    lines = ["## Process health", "",
+             "From every heartbeat: the worst state between two heartbeats, whether a FAULT "
+             "latched (and what it was), rejected inputs in total and those with an "
+             "implausible time (docs/operations.md, \"Health\").", "",
+             "| process | worst state | fault latched | rejected | time implausible |",
+             "| --- | --- | --- | --- | --- |"]
+    for process, beats in sorted(rows.items()):
+        severity = max(SEVERITY.get(int(b["worst_state"]), 0) for b in beats)
+        worst = {2: "FAULT", 1: "degraded", 0: "ok"}[severity]
+        latched = [b for b in beats if b["fault_latched"] == "1"]
+        last = beats[-1]
+        counters = dict(item.split("=", 1) for item in last["counters"].split(";") if "=" in item)
+        implausible = sum(int(v) for k, v in counters.items() if k.endswith("_time_implausible"))
+        latched_text = f"yes: {latched[0]['latched_error']}" if latched else "no"
+        lines.append(f"| {process} | {worst} | {latched_text} | "
+                     f"{last['rejected_inputs']} | {implausible} |")
+    return lines + [""]
+
+
+SUPERVISOR_STATES = {0: "DISARMED", 1: "ARMING", 2: "ARMED", 3: "HOLD", 4: "ESTOP"}
+
+
+def supervisor_section(run, config):
+    """The supervisor's states through the run (docs/operations.md, "Arming and e-stop"):
+    each change with its stack time and reason, from the recorded supervisor_state_t."""
+    lcm = config["lcm"]
+    channel = lcm["channels"].get("supervisor")
+    if not channel:
+        return []
+    name = lcm["channel_prefix"] + channel + (lcm.get("channel_suffix") or "")
+    path = os.path.join(run, "csv", name + ".csv")
+    if not os.path.exists(path):
+        return []
+    with open(path) as f:
+        rows = list(csv.DictReader(f))
+    if not rows:
+        return []
+    lines = ["## Supervisor", "",
+             "State changes of the supervisor (stack time of the decision; docs/operations.md, "
+             "\"Arming and e-stop\"). The motion clock is the stack time spent ARMING or ARMED.",
+             "", "| t (s) | state | reason |", "| --- | --- | --- |"]
+    previous = None
+    for row in rows:
+        key = (row["state"], row["transitions"])
+        if key == previous:
+            continue
+        previous = key
+        t = int(row["utime_us"]) * 1e-6
+        lines.append(f"| {t:.3f} | {SUPERVISOR_STATES.get(int(row['state']), row['state'])} | "
+                     f"{row['reason']} |")
+    last = rows[-1]
+    lines += ["", f"At the end: {SUPERVISOR_STATES.get(int(last['state']), last['state'])}, "
+              f"motion clock {int(last['motion_time_us']) * 1e-6:.3f} s, operator commands "
+              f"accepted {last['operator_commands_accepted']}, rejected "
+              f"{last['operator_commands_rejected']}.", ""]
+    return lines
 
 
 def plant_counters(run, config):
@@ -232,6 +307,8 @@ def main():
                 if over > 0:
                     exceeded.append(f"{axis} {kind} {side}")
     lines += ["", "Exceeded: " + (", ".join(exceeded) if exceeded else "none"), ""]
+    lines += supervisor_section(run, config)
+    lines += health_section(run, config)
 
     if diag is not None:
         dt = np.median(np.diff(diag["utime_us"])) * 1e-6 if len(diag["utime_us"]) > 1 else 0.0

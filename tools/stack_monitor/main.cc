@@ -31,6 +31,9 @@ class Monitor {
   // 1 kHz streams: a monitor must not compete with the loop for the CPUs.
   void OnHealth(const lcm::ReceiveBuffer*, const std::string&, const health_t* msg) {
     health_[msg->name] = *msg;
+    // Two heartbeats can come between two progress lines: the worst of them.
+    int8_t& worst = worst_since_print_.try_emplace(msg->name, msg->worst_state).first->second;
+    if (Severity(msg->worst_state) >= Severity(worst)) worst = msg->worst_state;
     if ((msg->name == "plant_sim" || msg->name == "hw_bridge") && msg->sample_utime > 0) {
       if (first_sample_utime_ < 0) first_sample_utime_ = msg->sample_utime;
       newest_sample_utime_ = msg->sample_utime;
@@ -43,7 +46,8 @@ class Monitor {
                ? 0.0
                : 1e-6 * static_cast<double>(newest_sample_utime_ - first_sample_utime_);
   }
-  std::string Summary() const {
+  /// The progress line's text; starts the next period of the worst states.
+  std::string Summary() {
     std::ostringstream s;
     const auto safety = health_.find("safety");
     if (safety != health_.end() && safety->second.messages_out > 0) {
@@ -54,15 +58,28 @@ class Monitor {
       if (Counter(h, "infeasible") > 0) s << ", infeasible " << Counter(h, "infeasible");
     }
     for (const auto& [name, h] : health_) {
-      if (h.rejected_inputs > 0 || h.state >= health_t::STATE_DEGRADED) {
-        s << " | " << name << ": state " << int{h.state} << ", rejected " << h.rejected_inputs;
+      const int8_t worst = worst_since_print_.count(name) ? worst_since_print_.at(name) : h.state;
+      if (h.rejected_inputs > 0 || Severity(worst) > 0 || h.fault_latched) {
+        s << " | " << name << ": state " << StateName(h.state);
+        if (worst != h.state) s << " (" << StateName(worst) << " since the last line)";
+        if (h.fault_latched) s << ", FAULT latched (" << h.latched_error << ")";
+        s << ", rejected " << h.rejected_inputs << " (+" << h.rejected_inputs_delta << ")";
         if (!h.last_error.empty()) s << " (" << h.last_error << ")";
       }
     }
+    for (auto& [name, worst] : worst_since_print_) worst = health_.at(name).state;
     return s.str();
   }
 
  private:
+  /// FAULT 2, DEGRADED 1, the others 0 (as health_state::Severity).
+  static int Severity(int8_t state) {
+    return state == health_t::STATE_FAULT ? 2 : state == health_t::STATE_DEGRADED ? 1 : 0;
+  }
+  static const char* StateName(int8_t state) {
+    static const char* const kNames[] = {"starting", "ok", "DEGRADED", "FAULT", "stopped"};
+    return state >= 0 && state <= 4 ? kNames[state] : "?";
+  }
   static int64_t Counter(const health_t& h, const std::string& name) {
     for (int i = 0; i < h.num_counters; ++i) {
       if (h.counter_names[static_cast<size_t>(i)] == name) {
@@ -73,6 +90,7 @@ class Monitor {
   }
 
   std::map<std::string, health_t> health_;
+  std::map<std::string, int8_t> worst_since_print_;
   int64_t first_sample_utime_ = -1;
   int64_t newest_sample_utime_ = 0;
 };

@@ -15,6 +15,10 @@ struct ControllerConfig {
   /// the state's estimate of the model error d (docs/controller.md).
   bool compensate_disturbance = true;
   double leg_friction_nspm = 0.0;  ///< N per m/s of leg speed
+  /// Optional key `stale_age_s` (default 0.02 s, safety.stale_age_s's
+  /// default): rejecting every state estimate for longer than this is a
+  /// FAULT (common/input_starvation.h).
+  double stale_age_s = 0.02;
 };
 
 }  // namespace stewart

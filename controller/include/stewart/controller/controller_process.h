@@ -3,10 +3,17 @@
 // acts on, what it rejects and counts, the nominal command it publishes and
 // the setpoint it echoes. The node (controller/node) converts messages and
 // publishes; replay drives the same class over a recorded log.
+//
+// The state estimates carry the stack time: one whose time is implausible
+// (common/input_time_check.h) is rejected before the control law sees it.
+// OnState takes the message's receive time (wall clock, us) from the live
+// node, nullopt in replay; it only widens the window after a gap and never
+// reaches the control law, whose time is the state's.
 #include <cstdint>
 #include <optional>
 
 #include "stewart/common/health_counters.h"
+#include "stewart/common/input_time_check.h"
 #include "stewart/common/signals.h"
 #include "stewart/controller/controller.h"
 
@@ -28,17 +35,20 @@ struct ControllerProcessOutput {
 };
 
 /// Why a state estimate produced no command (kPublished when it did).
-enum class ControllerVerdict { kPublished, kStateNotUsable, kStepRejected };
+enum class ControllerVerdict { kPublished, kStateNotUsable, kStepRejected, kTimeImplausible };
 
 class ControllerProcess {
  public:
-  /// `counters` must outlive this object.
+  /// `counters` must outlive this object; `time`: lcm.time_window_s,
+  /// lcm.max_time_rate. A stream of states rejected whole for longer than
+  /// gains.stale_age_s is a FAULT.
   ControllerProcess(const PlatformParams& platform, const ControllerConfig& gains,
                     const Vector6d& home_pose, std::optional<Scenario> scenario,
-                    HealthCounters* counters);
+                    HealthCounters* counters, const TimePlausibilityParams& time = {});
 
   /// A state estimate arrived: kPublished fills `out`.
-  ControllerVerdict OnState(const StateSample& state, ControllerProcessOutput* out);
+  ControllerVerdict OnState(const StateSample& state, ControllerProcessOutput* out,
+                            std::optional<int64_t> receive_wall_us = std::nullopt);
   /// A live setpoint arrived (only without a scenario).
   void OnSetpoint(const Setpoint& setpoint);
   /// The supervisor's state arrived: its motion clock (Controller::SetMotionClock).
@@ -51,6 +61,7 @@ class ControllerProcess {
  private:
   Controller controller_;
   HealthCounters* counters_;
+  InputTimeCheck time_check_;
   int64_t command_seq_ = 0;
   int64_t setpoint_seq_ = 0;
 };

@@ -5,8 +5,10 @@
 // (ground truth republished, testing only). The node (estimator/node)
 // converts messages and publishes; replay drives the same class.
 #include <cstdint>
+#include <optional>
 
 #include "stewart/common/health_counters.h"
+#include "stewart/common/input_time_check.h"
 #include "stewart/common/signals.h"
 #include "stewart/estimator/ekf.h"
 
@@ -19,18 +21,25 @@ StateSample StateFromEstimate(const Estimate& estimate, int64_t seq);
 class EstimatorProcess {
  public:
   /// `counters` must outlive this object.
+  /// `time`: lcm.time_window_s, lcm.max_time_rate. A stream of samples
+  /// rejected whole for longer than estimator.max_dt_s (the gap after which
+  /// the EKF restarts) is a FAULT.
   EstimatorProcess(const PlatformParams& platform, const ActuatorConfig& actuators,
                    const SensorConfig& sensors, const EstimatorConfig& estimator,
-                   const Vector6d& home_pose, HealthCounters* counters);
+                   const Vector6d& home_pose, HealthCounters* counters,
+                   const TimePlausibilityParams& time = {});
 
-  /// A safe command arrived: the process model's input (non-finite ones are
-  /// rejected).
-  void OnCommand(const ForceCommand& command);
+  /// A safe command arrived: the process model's input (non-finite ones and
+  /// ones with an implausible time are rejected).
+  void OnCommand(const ForceCommand& command,
+                 std::optional<int64_t> receive_wall_us = std::nullopt);
   /// A sensor sample arrived. Returns true when `out` holds an estimate to
   /// publish.
-  bool OnSensor(const SensorSample& sample, StateSample* out);
+  bool OnSensor(const SensorSample& sample, StateSample* out,
+                std::optional<int64_t> receive_wall_us = std::nullopt);
   /// Perfect-state mode: the ground truth, republished as the estimate.
-  bool OnTruth(const StateSample& truth, StateSample* out);
+  bool OnTruth(const StateSample& truth, StateSample* out,
+               std::optional<int64_t> receive_wall_us = std::nullopt);
 
   const Ekf& ekf() const { return ekf_; }
 
@@ -40,6 +49,7 @@ class EstimatorProcess {
 
   Ekf ekf_;
   HealthCounters* counters_;
+  InputTimeCheck time_check_;
   int64_t seq_ = 0;
 };
 

@@ -3,6 +3,8 @@
 // every channel name. Header-only, shared by the nodes, replay and the loader.
 #include <string>
 
+#include "stewart/common/time_plausibility.h"
+
 namespace stewart {
 
 /// Full channel names: lcm.channel_prefix + lcm.channels.<name> + suffix.
@@ -28,6 +30,9 @@ struct LcmConfig {
   double health_rate_hz = 2.0;
   /// Key of the authenticated channels (node/message_auth.h); "" = off.
   std::string auth_key_file;
+  /// How far a message's stack time may be from its receiver's
+  /// (lcm.time_window_s, lcm.max_time_rate; common/time_plausibility.h).
+  TimePlausibilityParams time_plausibility;
 };
 
 /// Every channel: its config key under lcm.channels and its field.

@@ -10,8 +10,9 @@
 namespace stewart {
 
 /// The event loop of a message-driven node: handles the receiver's traffic
-/// and beats the heartbeat (published through `lcm`) until a stop signal or
-/// until `done()` returns true. A
+/// (the operator's RESETs included, operator_reset.h) and beats the
+/// heartbeat (published through `lcm`) until a stop signal or until
+/// `done()` returns true. A
 /// receive error reports FAULT and returns kFault; a clean stop reports
 /// STOPPED and returns kOk. A stop signal interrupting the wait (EINTR) is a clean stop.
 /// Puts the receiver's counts of unusable input into the heartbeat:
@@ -20,6 +21,6 @@ namespace stewart {
 void ReportReceiverCounters(const LcmReceiver& receiver, HealthReporter* health);
 
 ExitCode RunNodeLoop(const std::string& name, lcm::LCM* lcm, LcmReceiver* receiver,
-                HealthReporter* health, int poll_ms, const std::function<bool()>& done = {});
+                     HealthReporter* health, int poll_ms, const std::function<bool()>& done = {});
 
 }  // namespace stewart

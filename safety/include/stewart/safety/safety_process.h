@@ -7,10 +7,18 @@
 // closed loop call the same class, so they decide as the process does.
 //
 // All timing comes from message utimes (stack time), never the wall clock.
+// The state estimates carry it: one whose time is implausible
+// (common/input_time_check.h) is rejected before anything else sees it, as
+// is a nominal command whose time is implausible against them. OnState and
+// OnNominal take the message's receive time (wall clock, us) from the live
+// node, nullopt in replay; it only widens the window after a gap and never
+// reaches the filter, the watchdog or a command.
 #include <array>
 #include <cstdint>
+#include <optional>
 
 #include "stewart/common/health_counters.h"
+#include "stewart/common/input_time_check.h"
 #include "stewart/common/signals.h"
 #include "stewart/safety/safety_filter.h"
 #include "stewart/safety/supervisor.h"
@@ -34,21 +42,26 @@ class SafetyProcess {
   /// `counters` receives rejections and the process counters
   /// (fallback_commands, active_steps, infeasible, nominal_before_state,
   /// hold_commands, drive_off_commands) and must outlive this object;
-  /// `reference` as for SafetyFilter. Every command goes through the
+  /// `reference` as for SafetyFilter; `time`: lcm.time_window_s,
+  /// lcm.max_time_rate (a stream of states rejected whole for longer than
+  /// safety.stale_age_s is a FAULT). Every command goes through the
   /// supervisor: DISARMED and ESTOP turn the drive off, HOLD sends the safe
   /// stop, ARMING blends the safe stop into the filtered command.
   SafetyProcess(const PlatformParams& platform, const SafetyConfig& safety,
                 const ActuatorConfig& actuators, const SupervisorConfig& supervisor,
-                ReferenceQpSolver* reference, HealthCounters* counters);
+                ReferenceQpSolver* reference, HealthCounters* counters,
+                const TimePlausibilityParams& time = {});
 
   /// A state estimate arrived. Returns true when `out` holds a command to
   /// publish: the pending nominal command for this state, filtered; or a
   /// fallback (state not usable, or no recent nominal command: the watchdog).
-  bool OnState(const StateSample& state, SafetyOutput* out);
+  bool OnState(const StateSample& state, SafetyOutput* out,
+               std::optional<int64_t> receive_wall_us = std::nullopt);
 
   /// A nominal command arrived. Returns true when `out` holds a command to
   /// publish: the filtered command, or a fallback for a stale one.
-  bool OnNominal(const ForceCommand& nominal, SafetyOutput* out);
+  bool OnNominal(const ForceCommand& nominal, SafetyOutput* out,
+                 std::optional<int64_t> receive_wall_us = std::nullopt);
 
   const SafetyFilter& filter() const { return filter_; }
   /// The supervisor, for operator commands and outside faults (the node,
@@ -78,6 +91,7 @@ class SafetyProcess {
   SafetyDiagnostics hold_diagnostics_{};  // the safe stop blended in while ARMING
   HealthCounters* counters_;
   const int64_t stale_age_us_;
+  InputTimeCheck time_check_;
 
   // The states the next nominal commands can refer to (a command derives
   // from one state estimate, matched by sample_utime).
@@ -86,13 +100,15 @@ class SafetyProcess {
   int states_count_ = 0;
   int states_next_ = 0;
   int64_t newest_state_utime_ = -1;
+  /// The newest sample a nominal command answered, among the states that
+  /// arrived: a nominal ahead of every state (pending) counts once its state
+  /// arrives, so a nominal for a state that never comes cannot feed the
+  /// watchdog.
   int64_t newest_nominal_sample_utime_ = -1;
   int64_t last_published_sample_utime_ = -1;
   // A nominal command that arrived before its state (see OnNominal).
   ForceCommand pending_nominal_{};
   bool has_pending_nominal_ = false;
-  /// newest_nominal_sample_utime_ before the pending nominal arrived.
-  int64_t newest_nominal_before_pending_ = -1;
   int64_t first_usable_state_utime_ =
       -1;  ///< first usable state since start or the last unusable one
   int64_t seq_ = 0;

@@ -23,10 +23,13 @@
 #include "stewart/config/stack_config.h"
 #include "stewart/controller/scenario.h"
 #include "stewart/force_command_t.hpp"
+#include "stewart/health_t.hpp"
+#include "stewart/operator_command_t.hpp"
 #include "stewart/safety/reference_qp.h"
 #include "stewart/safety/two_constraint_qp.h"
 #include "stewart/sensor_t.hpp"
 #include "stewart/state_t.hpp"
+#include "stewart/supervisor_state_t.hpp"
 
 namespace stewart::replay {
 
@@ -55,8 +58,11 @@ enum class Channel {
   kCommandNominal,
   kCommandSafe,
   kSafetyDiagnostics,
+  kSupervisor,  ///< supervisor_state_t: the motion clock the controller runs on
+  kOperator,    ///< operator_command_t: what the live supervisor was told
+  kHealth,      ///< health_t: the heartbeats the live supervisor watched
 };
-constexpr int kNumChannels = 6;
+constexpr int kNumChannels = 9;
 
 /// Messages of one channel missing from the log, from gaps in `seq` (which
 /// increments by one per message): lcm-logger drops bursts when it is
@@ -77,6 +83,11 @@ struct RecordedLog {
   std::vector<force_command_t> nominal;
   std::vector<force_command_t> safe;
   std::vector<RecordedDiagnostics> diagnostics;
+  std::vector<supervisor_state_t> supervisor;
+  std::vector<operator_command_t> operator_commands;
+  std::vector<health_t> health;
+  /// Logger receive time (wall clock, us) of each entry of `order`.
+  std::vector<int64_t> order_timestamp_us;
   /// Every decoded message above in log order: its channel and its index in
   /// that channel's vector (the estimator interleaves sensors and commands).
   std::vector<std::pair<Channel, int>> order;
