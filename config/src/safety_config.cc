@@ -88,6 +88,12 @@ SafetyConfig ParseSafetyConfig(const ConfigNode& safety) {
   if (safety.Has("disturbance_sigma")) {
     s.disturbance_sigma = safety.NonNegativeDouble("disturbance_sigma");
   }
+  if (safety.Has("per_period_velocity_step_mps")) {
+    s.per_period_velocity_step_mps = safety.NonNegativeDouble("per_period_velocity_step_mps");
+  }
+  if (safety.Has("per_period_angular_step_radps")) {
+    s.per_period_angular_step_radps = safety.NonNegativeDouble("per_period_angular_step_radps");
+  }
   return s;
 }
 

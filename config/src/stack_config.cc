@@ -64,6 +64,9 @@ StackConfig ParseRoot(const YAML::Node& yaml, const std::string& source) {
   const double leg_damping_nspm = ModelLegDampingNspm(c.actuators);
   c.controller.leg_friction_nspm = c.controller.compensate_friction ? leg_damping_nspm : 0.0;
   c.safety.leg_friction_nspm = c.safety.model_leg_friction ? leg_damping_nspm : 0.0;
+  // One sample period of the plant's zero-order hold: the nominal's bound
+  // (safety/nominal_bound.h) is a velocity step per period.
+  c.safety.sample_period_s = 1.0 / c.sensors.rate_hz;
   ValidateStackConfig(c);
   return c;
 }

@@ -115,6 +115,22 @@ void BM_ClosedFormFullStep(benchmark::State& state) {
 }
 BENCHMARK(BM_ClosedFormFullStep);
 
+// (b) without the per-period bound on the nominal (nominal_bound.h), and
+// without it and the force limits (the shipped config before both).
+void BM_ClosedFormFullStepNoNominalBound(benchmark::State& state) {
+  SafetyConfig s = DefaultStackConfig().safety;
+  s.sample_period_s = 0.0;
+  RunFullStep(state, s);
+}
+BENCHMARK(BM_ClosedFormFullStepNoNominalBound);
+void BM_ClosedFormFullStepNoBoundNoForceLimits(benchmark::State& state) {
+  SafetyConfig s = DefaultStackConfig().safety;
+  s.sample_period_s = 0.0;
+  s.force_limits_enabled = false;
+  RunFullStep(state, s);
+}
+BENCHMARK(BM_ClosedFormFullStepNoBoundNoForceLimits);
+
 // (a) with the paper's force metric (no metric map per step).
 void BM_ClosedFormCoreForceMetric(benchmark::State& state) {
   SafetyConfig s = DefaultStackConfig().safety;

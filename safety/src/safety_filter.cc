@@ -3,9 +3,11 @@
 #include <Eigen/QR>
 #include <chrono>
 #include <cmath>
+#include <limits>
 
 #include "stewart/common/check.h"
 #include "stewart/model/linear_algebra6.h"
+#include "stewart/safety/nominal_bound.h"
 
 namespace stewart::safety {
 namespace {
@@ -52,6 +54,7 @@ bool AccelerationMetricMap(const Matrix6d& h, const Cholesky6& inertia, Matrix6d
 }
 
 const Vector6d kNoDisturbance = Vector6d::Zero();
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
 FilterCase CaseFromMultipliers(double mu_p, double mu_v) {
   if (mu_p > 0.0 && mu_v > 0.0) return FilterCase::kBoth;
@@ -74,7 +77,16 @@ SafetyFilter::SafetyFilter(const PlatformParams& platform, const SafetyConfig& s
       fallback_(safety.fallback),
       stop_time_s_(safety.stop_time_s),
       use_disturbance_(safety.use_disturbance_estimate),
+      nominal_max_accel_(NominalAccelerationBound(safety.sample_period_s,
+                                                  safety.per_period_velocity_step_mps,
+                                                  safety.per_period_angular_step_radps)),
+      bound_nominal_((nominal_max_accel_.array() < kInfinity).any()),
       reference_(reference) {
+  STEWART_CHECK_INPUT(safety.sample_period_s >= 0.0, "safety.sample_period_s", "must be >= 0");
+  STEWART_CHECK_INPUT(safety.per_period_velocity_step_mps >= 0.0,
+                      "safety.per_period_velocity_step_mps", "must be >= 0");
+  STEWART_CHECK_INPUT(safety.per_period_angular_step_radps >= 0.0,
+                      "safety.per_period_angular_step_radps", "must be >= 0");
   STEWART_CHECK_INPUT(force_limit_n_ > 0.0 || !force_limits_, "actuators.force_limit_n",
                       "must be positive when safety.force_limits_enabled");
   STEWART_CHECK_INPUT(stop_time_s_ > 0.0, "safety.stop_time_s", "must be positive");
@@ -144,9 +156,23 @@ Vector6d SafetyFilter::StepWithTerms(const DynamicsTerms& terms, const Vector6d&
   FilterWorkspace& ws = workspace_;
   const Vector6d& held_disturbance =
       use_disturbance_ && disturbance_valid ? disturbance.force_n : kNoDisturbance;
-  const StepInput in{terms, qd, f_des, d->barriers, held_disturbance};
+  // The conditions are solved for the nominal within the per-period bound
+  // (nominal_bound.h); correction and flags still compare with F_des.
+  d->nominal_scale = 1.0;
+  Vector6d& f_nominal = d->f_nominal;
+  f_nominal = f_des;
+  if (ok && bound_nominal_) {
+    const double scale = BoundNominal(terms, terms.H.transpose() * qd, leg_friction_nspm_,
+                                      held_disturbance, nominal_max_accel_, f_des, &f_nominal);
+    ok = scale > 0.0;
+    if (scale < 1.0) {
+      d->nominal_scale = scale;
+      d->flags |= kFlagNominalBounded;
+    }
+  }
+  const StepInput in{terms, qd, f_nominal, d->barriers, held_disturbance};
   if (ok) {
-    EvaluateBarriers(constraints_, q, qd, terms, f_des, leg_friction_nspm_,
+    EvaluateBarriers(constraints_, q, qd, terms, f_nominal, leg_friction_nspm_,
                      use_disturbance_ ? disturbance : GeneralizedDisturbance{}, &d->barriers,
                      &ws.barrier);
     ok = BarriersFinite(d->barriers) &&

@@ -154,6 +154,7 @@ SafetyOutput SafetyProcess::Filter(const StateSample& state, const ForceCommand&
       filter_.Step(state.q, state.qd, nominal.force_n, disturbance, &diagnostics_);
   if (diagnostics_.flags & kFlagInvalidInput) counters_->Reject("invalid_nominal");
   if (diagnostics_.flags & kFlagOutsideSafeSet) counters_->Count("outside_safe_set");
+  if (diagnostics_.flags & kFlagNominalBounded) counters_->Count("nominal_bounded");
   return Supervise(state, f_safe, nominal.sample_utime, 0);
 }
 

@@ -205,8 +205,8 @@ std::vector<std::string> CampaignColumns(const CampaignSpec& spec) {
   for (const std::string& name : limits) columns.push_back(name + "_margin");
   for (const char* name :
        {"tracking_rms_m", "estimate_rms_m", "estimate_rms_mps", "estimator_restarts",
-        "estimator_rejections", "fallback_ticks", "infeasible_ticks", "endstop_hits",
-        "stiff_fallbacks", "completed", "failure", "wall_s"}) {
+        "estimator_rejections", "fallback_ticks", "infeasible_ticks", "nominal_bounded_ticks",
+        "endstop_hits", "stiff_fallbacks", "completed", "failure", "wall_s"}) {
     columns.push_back(name);
   }
   return columns;
@@ -229,9 +229,9 @@ std::string CampaignCsvLine(const CampaignSpec& spec, const CampaignRow& row) {
   for (const LimitMargin& m : s.limit_margins) line << ',' << Number(m.worst_margin);
   line << ',' << Number(s.rms_translation_tracking_inside_m) << ',' << Number(s.rms_q_error) << ','
        << Number(s.rms_qd_error) << ',' << s.estimator_reinits << ',' << s.estimator_rejections
-       << ',' << s.fallback_ticks << ',' << s.infeasible_ticks << ',' << s.endstop_hits << ','
-       << s.stiff_fallbacks << ',' << (s.completed ? 1 : 0) << ',' << CsvField(s.failure) << ','
-       << Number(row.wall_s);
+       << ',' << s.fallback_ticks << ',' << s.infeasible_ticks << ',' << s.nominal_bounded_ticks
+       << ',' << s.endstop_hits << ',' << s.stiff_fallbacks << ',' << (s.completed ? 1 : 0) << ','
+       << CsvField(s.failure) << ',' << Number(row.wall_s);
   return line.str();
 }
 

@@ -27,6 +27,7 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <string>
 #include <thread>
@@ -127,7 +128,11 @@ TEST(ForgedTimeStack, LockstepRunSurvivesForgedTimesAndTheWatchdogStillFires) {
   };
   const auto pump_for = [&](double seconds) { pump_until([] { return false; }, seconds); };
 
-  const std::vector<std::string> common = {"--lcm-url", url, "--log-level", "warn"};
+  // Armed by the supervisor at start-up, as tools/launch.sh does in simulation.
+  const std::string overlay = folder + "/auto_arm.yaml";
+  std::ofstream(overlay) << "supervisor:\n  auto_arm: true\n";
+  const std::vector<std::string> common = {"--lcm-url", url,           "--overlay",
+                                           overlay,     "--log-level", "warn"};
   // As tools/launch.sh runs them: the loop on the last CPU, the logger and
   // this test on the others (docs/operations.md, "One CPU for the loop").
   const long cpus = sysconf(_SC_NPROCESSORS_ONLN);
@@ -248,6 +253,8 @@ TEST(ForgedTimeStack, LockstepRunSurvivesForgedTimesAndTheWatchdogStillFires) {
   // checked on every sample it has.
   EXPECT_GE(static_cast<double>(run.truth_samples), 0.9 * kDurationS * config.sensors.rate_hz);
   test::ExpectWithinLimits(run);
+  // Armed and under way: the paper scenario's x step (0.1 m within 6 s).
+  EXPECT_GT(run.max_x, 0.05) << "the platform did not move";
   if (!::testing::Test::HasFailure()) {
     std::error_code ignored;
     std::filesystem::remove_all(folder, ignored);

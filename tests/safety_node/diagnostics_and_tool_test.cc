@@ -77,11 +77,13 @@ TEST(DiagnosticsMessage, CarriesEveryFilterQuantity) {
     EXPECT_EQ(msg.g_v[i], d.barriers.g_v(i));
     EXPECT_EQ(msg.g_p[i], d.barriers.g_p(i));
     EXPECT_EQ(msg.f_des[i], s.f_des(i));
+    EXPECT_EQ(msg.f_nominal[i], d.f_nominal(i));
     EXPECT_EQ(msg.f_safe[i], f(i));
   }
   EXPECT_EQ(msg.correction_norm, d.correction_norm);
+  EXPECT_EQ(msg.nominal_scale, d.nominal_scale);
   EXPECT_EQ(msg.compute_ns, d.compute_ns);
-  // Recheck from the message alone plus the model: F* - F_des is
+  // Recheck from the message alone plus the model: F* - F_nom is
   // W^-1 (mu_p g_p + mu_v g_v) in the acceleration metric.
   const DynamicsTerms t = EvaluateDynamics(DefaultStackConfig().platform, s.q, s.qd);
   const Matrix6d w = t.H.transpose() * t.M.inverse() * t.H;
@@ -89,7 +91,7 @@ TEST(DiagnosticsMessage, CarriesEveryFilterQuantity) {
   for (int i = 0; i < 6; ++i) {
     g_p(i) = msg.g_p[i];
     g_v(i) = msg.g_v[i];
-    f_des(i) = msg.f_des[i];
+    f_des(i) = msg.f_nominal[i];
     f_safe(i) = msg.f_safe[i];
   }
   const Vector6d predicted = f_des + w.inverse() * (msg.mu_p * g_p + msg.mu_v * g_v);

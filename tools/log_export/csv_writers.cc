@@ -145,7 +145,8 @@ class DiagnosticsWriter : public TypedWriter<safety_diagnostics_t> {
            IndexedColumns("w_position", kPositionColumns, "") +
            IndexedColumns("w_velocity", kVelocityColumns, "") +
            IndexedColumns("mu_position", kPositionColumns, "") +
-           IndexedColumns("mu_velocity", kVelocityColumns, "");
+           IndexedColumns("mu_velocity", kVelocityColumns, "") +
+           IndexedColumns("f_nominal", 6, "n") + ",nominal_scale,flags";
   }
   void Row(const safety_diagnostics_t& m, std::ostream& out) const override {
     out << ',' << int{m.variant} << ',' << int{m.correction_metric} << ',' << int{m.active_case}
@@ -164,6 +165,8 @@ class DiagnosticsWriter : public TypedWriter<safety_diagnostics_t> {
     Values(out, m.w_velocity, kVelocityColumns);
     Values(out, m.mu_position, kPositionColumns);
     Values(out, m.mu_velocity, kVelocityColumns);
+    Values(out, m.f_nominal);
+    out << ',' << m.nominal_scale << ',' << m.flags;
   }
 };
 

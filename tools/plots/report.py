@@ -76,9 +76,8 @@ def health_section(run, config):
 SUPERVISOR_STATES = {0: "DISARMED", 1: "ARMING", 2: "ARMED", 3: "HOLD", 4: "ESTOP"}
 
 
-def supervisor_section(run, config):
-    """The supervisor's states through the run (docs/operations.md, "Arming and e-stop"):
-    each change with its stack time and reason, from the recorded supervisor_state_t."""
+def supervisor_rows(run, config):
+    """The recorded supervisor_state_t rows (the log export's CSV), [] without them."""
     lcm = config["lcm"]
     channel = lcm["channels"].get("supervisor")
     if not channel:
@@ -88,7 +87,13 @@ def supervisor_section(run, config):
     if not os.path.exists(path):
         return []
     with open(path) as f:
-        rows = list(csv.DictReader(f))
+        return list(csv.DictReader(f))
+
+
+def supervisor_section(run, config):
+    """The supervisor's states through the run (docs/operations.md, "Arming and e-stop"):
+    each change with its stack time and reason, from the recorded supervisor_state_t."""
+    rows = supervisor_rows(run, config)
     if not rows:
         return []
     lines = ["## Supervisor", "",
@@ -359,7 +364,7 @@ def main():
 
     lines += replay_section(run)
 
-    fig, axes = plt.subplots(4, 3, figsize=(14, 11), sharex=True)
+    fig, axes = plt.subplots(5, 3, figsize=(14, 13), sharex=True)
     limits = {(l["axis"], kind): l for kind in ("position", "velocity")
               for l in safety[f"{kind}_limits"]}
     for j, axis in enumerate(AXES[:3]):
@@ -393,6 +398,25 @@ def main():
         axes[3, 1].set_ylabel("||F* - F_des|| (N)")
         axes[3, 2].plot(td, diag["compute_ns"] / 1e3, lw=0.5)
         axes[3, 2].set_ylabel("filter time (us)")
+    supervisor = supervisor_rows(run, config)
+    if supervisor:
+        ts = [(int(r["utime_us"]) - t0) * 1e-6 for r in supervisor]
+        axes[4, 0].step(ts, [int(r["state"]) for r in supervisor], where="post", lw=0.8)
+    axes[4, 0].set_yticks(list(SUPERVISOR_STATES))
+    axes[4, 0].set_yticklabels(list(SUPERVISOR_STATES.values()), fontsize=7)
+    axes[4, 0].set_ylabel("supervisor")
+    if diag is not None and "nominal_scale" in diag:
+        axes[4, 1].plot(td, diag["nominal_scale"], lw=0.8)
+    axes[4, 1].set_ylabel("nominal scale s\n(1: within the per-period bound)", fontsize=8)
+    flag_bits = ((4, "fallback"), (2, "infeasible"), (128, "outside"), (256, "drive off"),
+                 (512, "bounded"))
+    if diag is not None and "flags" in diag:
+        flags = diag["flags"].astype(int)
+        for row, (bit, _) in enumerate(flag_bits):
+            axes[4, 2].step(td, row + 0.8 * ((flags & bit) != 0), where="post", lw=0.8)
+    axes[4, 2].set_yticks([row + 0.4 for row in range(len(flag_bits))])
+    axes[4, 2].set_yticklabels([label for _, label in flag_bits], fontsize=7)
+    axes[4, 2].set_ylabel("command flags")
     for ax in axes[-1]:
         ax.set_xlabel("t (s)")
     fig.suptitle(f"Fig. 5 equivalent: {os.path.basename(os.path.normpath(run))}")

@@ -64,5 +64,8 @@ constexpr int32_t kCommandOutsideSafeSet = 128;
 /// Actuators off, the lead screws hold the legs (supervisor DISARMED or
 /// ESTOP); force_n is zero.
 constexpr int32_t kCommandDriveOff = 256;
+/// The nominal asked for more acceleration than one sample period allows;
+/// the filter solved its conditions for the scaled nominal.
+constexpr int32_t kCommandNominalBounded = 512;
 
 }  // namespace stewart

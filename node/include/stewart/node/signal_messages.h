@@ -24,7 +24,8 @@ static_assert(kCommandFilterActive == force_command_t::FLAG_FILTER_ACTIVE &&
                   kCommandSetpointRejected == force_command_t::FLAG_SETPOINT_REJECTED &&
                   kCommandForceLimited == force_command_t::FLAG_FORCE_LIMITED &&
                   kCommandOutsideSafeSet == force_command_t::FLAG_OUTSIDE_SAFE_SET &&
-                  kCommandDriveOff == force_command_t::FLAG_DRIVE_OFF,
+                  kCommandDriveOff == force_command_t::FLAG_DRIVE_OFF &&
+                  kCommandNominalBounded == force_command_t::FLAG_NOMINAL_BOUNDED,
               "signals.h and force_command_t.FLAG_* must agree");
 
 /// For each message, the library signal it carries and the fields both share

@@ -20,6 +20,9 @@ enum FilterFlag : std::int32_t {
   /// A limit is exceeded (some h < 0): the filter steers back into the safe
   /// set (docs/safety.md, "Outside the safe set").
   kFlagOutsideSafeSet = 128,
+  /// F_des asked for more acceleration than one sample period allows
+  /// (nominal_bound.h): the conditions were solved for the scaled nominal.
+  kFlagNominalBounded = 512,
 };
 
 struct SafetyDiagnostics {
@@ -41,9 +44,17 @@ struct SafetyDiagnostics {
   /// Force-limit multipliers, signed: + upper bound active, - lower.
   /// F* = F_des + mu_p g_p + mu_v g_v - mu_force.
   Vector6d mu_force = Vector6d::Zero();
-  Vector6d f_des = Vector6d::Zero();   ///< nominal force as received (N)
+  Vector6d f_des = Vector6d::Zero();  ///< nominal force as received (N)
+  /// F_nom, the nominal the conditions were solved for: F_des within the
+  /// per-period bound (nominal_bound.h), F_des itself when nominal_scale is 1.
+  /// psi_p, psi_v (barriers) are taken at it, and the KKT multipliers relate
+  /// F* to it: F* = F_nom + W^-1 (mu_p g_p + mu_v g_v - mu_force).
+  Vector6d f_nominal = Vector6d::Zero();
   Vector6d f_safe = Vector6d::Zero();  ///< F* (N)
   double correction_norm = 0.0;        ///< ||F* - F_des|| (N)
+  /// s of the per-period bound (nominal_bound.h): the conditions were solved
+  /// for F_0 + s (F_des - F_0); 1 when F_des was within the bound.
+  double nominal_scale = 1.0;
   /// Wall time of SafetyFilter::Step (model terms and filter, one pair of
   /// clock reads per step); 0 from StepWithTerms, which is not timed.
   std::int64_t compute_ns = 0;

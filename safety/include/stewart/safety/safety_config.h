@@ -98,6 +98,15 @@ struct SafetyConfig {
   /// "Model error").
   bool use_disturbance_estimate = true;
   double disturbance_sigma = 3.0;
+  /// Optional keys: the largest velocity change one sample period of the
+  /// nominal command may ask of the model (nominal_bound.h; docs/safety.md,
+  /// "One sample period"): x, y, z (m/s) and Euler angles (rad/s). 0 turns
+  /// an axis group's bound off.
+  double per_period_velocity_step_mps = 0.001;
+  double per_period_angular_step_radps = 0.01;
+  /// The plant's zero-order-hold period T (s): 1 / sensors.rate_hz, set by
+  /// ParseStackConfig. 0 (a config built in code) turns the bound off.
+  double sample_period_s = 0.0;
 };
 
 inline std::string ToString(SafetyVariant variant) {

@@ -116,6 +116,9 @@ class SafetyFilter {
   CorrectionMetric correction_metric() const { return metric_; }
   double leg_friction_nspm() const { return leg_friction_nspm_; }
   double force_limit_n() const { return force_limit_n_; }
+  /// Largest model acceleration per axis a nominal may ask for (m/s^2,
+  /// rad/s^2; nominal_bound.h): +Inf on every axis when the bound is off.
+  const Vector6d& nominal_max_accel() const { return nominal_max_accel_; }
 
  private:
   /// The inputs of one step, as the private steps read them.
@@ -166,6 +169,8 @@ class SafetyFilter {
   SafetyFallback fallback_;
   double stop_time_s_;
   bool use_disturbance_;
+  Vector6d nominal_max_accel_;
+  bool bound_nominal_;
   ReferenceQpSolver* reference_;
   /// The data of the step under way (filter_workspace.h): written by every
   /// step before it is read, so a const step changes nothing observable.

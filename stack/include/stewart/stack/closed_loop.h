@@ -3,6 +3,7 @@
 // stewart_closed_loop_sim and by tests that need many closed-loop runs.
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <ostream>
 #include <string>
@@ -26,6 +27,10 @@ struct ClosedLoopOptions {
   /// The plant's physics; absent: the config's own (TruthOfConfig). The
   /// estimator, controller and filter always use `config`.
   std::optional<PlantTruth> truth;
+  /// An attacker on CMD_NOMINAL: called with each tick's nominal force (N)
+  /// before safety filters it; may replace it (tests of the per-period
+  /// bound, docs/safety.md "One sample period").
+  std::function<void(long tick, Vector6d* force_n)> forge_nominal;
 };
 
 /// One configured limit and how close ground truth came to it over a run:
@@ -54,6 +59,8 @@ struct ClosedLoopSummary {
   double rms_qd_error = 0.0;  ///< estimate vs truth, translational rates (m/s)
   safety::FilterCaseCounts case_ticks{};  ///< ticks per FilterCase
   long infeasible_ticks = 0;
+  /// Ticks whose nominal exceeded the per-period bound (FLAG_NOMINAL_BOUNDED).
+  long nominal_bounded_ticks = 0;
   long fallback_ticks = 0;        ///< ticks the safety process answered with its fallback
   long endstop_hits = 0;          ///< legs entering an end-stop (plant)
   long stiff_fallbacks = 0;       ///< plant intervals the BDF fallback integrated (Plant)

@@ -107,11 +107,13 @@ inline void FillDiagnosticsMessage(const SafetyFilter& filter, const SafetyDiagn
     msg->g_v[i] = b.g_v(i);
     msg->mu_force[i] = d.mu_force(i);
     msg->f_des[i] = std::isfinite(d.f_des(i)) ? d.f_des(i) : 0.0;  // never NaN on a channel
+    msg->f_nominal[i] = std::isfinite(d.f_nominal(i)) ? d.f_nominal(i) : 0.0;
     msg->f_safe[i] = d.f_safe(i);
   }
   msg->mu_p = d.mu_p;
   msg->mu_v = d.mu_v;
   msg->correction_norm = d.correction_norm;
+  msg->nominal_scale = d.nominal_scale;
   msg->compute_ns = d.compute_ns;
   msg->flags = d.flags;
   msg->force_limits = filter.force_limits();
