@@ -13,7 +13,7 @@ PACKAGES=(
   libsundials-dev
   liblcm-dev liblcm-bin liblcm-java libjchart2d-java default-jre-headless default-jdk-headless
   coinor-libclp-dev libalglib-dev
-  python3-matplotlib python3-numpy python3-pil python3-yaml
+  python3-matplotlib python3-numpy python3-pandas python3-pil python3-yaml
   xvfb xauth x11-utils imagemagick
   libssl-dev
   iproute2 procps
