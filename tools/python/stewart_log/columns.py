@@ -57,6 +57,7 @@ _BY_TYPE = {
         "mu_force": _indexed("mu_force", ""),
         "f_des": _indexed("f_des", "n"),
         "f_safe": _indexed("f_safe", "n"),
+        "f_nominal": _indexed("f_nominal", "n"),
         "correction_norm": "correction_norm_n",
     },
     "stewart.supervisor_state_t": {"mac": HEX},
