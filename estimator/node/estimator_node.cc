@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include "sensor_msg.h"
+#include "stewart/guard/guard_limits.h"
 #include "stewart/node/node_loop.h"
 #include "stewart/node/signal_messages.h"
 
@@ -13,8 +14,10 @@ EstimatorNode::EstimatorNode(const StackConfig& config, lcm::LCM* lcm, bool perf
       lcm_(lcm),
       receiver_(config.lcm.url),
       health_("estimator", config.lcm.channels.health, config.lcm.health_rate_hz),
+      auth_(MessageAuthenticator::FromKeyFile(config.lcm.auth_key_file)),
       process_(config.platform, config.actuators, config.sensors, config.estimator,
-               config.home_pose, &health_, config.lcm.time_plausibility) {
+               config.home_pose, &health_, config.lcm.time_plausibility,
+               AcceptorLimitsOf(config.guard, config.estimator.command_timeout_s)) {
   if (perfect_state) {
     spdlog::warn("estimator: PERFECT STATE mode: republishing {} as {} (testing only)",
                  config_.lcm.channels.state_truth, config_.lcm.channels.state_estimate);
@@ -22,12 +25,24 @@ EstimatorNode::EstimatorNode(const StackConfig& config, lcm::LCM* lcm, bool perf
   } else {
     receiver_.Subscribe(config_.lcm.channels.sensors, &EstimatorNode::OnSensor, this);
     receiver_.Subscribe(config_.lcm.channels.command_safe, &EstimatorNode::OnCommand, this);
+    receiver_.Subscribe(config_.lcm.channels.supervisor, &EstimatorNode::OnSupervisor, this);
+  }
+}
+
+void EstimatorNode::OnSupervisor(const lcm::ReceiveBuffer* rbuf, const std::string&,
+                                 const supervisor_state_t* msg) {
+  const AnnouncementVerdict v =
+      process_.OnAnnouncement(SessionAnnouncement{msg->utime, msg->seq, msg->session_id},
+                              auth_.Verify(*msg), rbuf->recv_utime);
+  if (v == AnnouncementVerdict::kAdopted) {
+    spdlog::info("estimator: believing safety session {} (announced at utime {})", msg->session_id,
+                 msg->utime);
   }
 }
 
 void EstimatorNode::OnCommand(const lcm::ReceiveBuffer* rbuf, const std::string&,
                               const force_command_t* msg) {
-  process_.OnCommand(FromMessage(*msg), rbuf->recv_utime);
+  process_.OnCommand(FromMessage(*msg), rbuf->recv_utime, auth_.Verify(*msg));
 }
 
 void EstimatorNode::OnSensor(const lcm::ReceiveBuffer* rbuf, const std::string&,

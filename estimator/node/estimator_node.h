@@ -2,8 +2,10 @@
 // The estimator process on LCM: sensor_t on channels.sensors and the safe
 // command (channels.command_safe, the process model's input) in, state_t on
 // channels.state_estimate out; in perfect-state mode channels.state_truth is
-// republished instead (testing only). Every decision is EstimatorProcess's;
-// this class subscribes, converts and publishes.
+// republished instead (testing only). The safety session's announcements
+// (channels.supervisor) decide, as in the actuators, which safe commands are
+// believed. Every decision is EstimatorProcess's; this class subscribes,
+// verifies MACs, converts and publishes.
 #include <lcm/lcm-cpp.hpp>
 #include <string>
 
@@ -13,8 +15,10 @@
 #include "stewart/node/exit_code.h"
 #include "stewart/node/health_reporter.h"
 #include "stewart/node/lcm_receiver.h"
+#include "stewart/node/message_auth.h"
 #include "stewart/sensor_t.hpp"
 #include "stewart/state_t.hpp"
+#include "stewart/supervisor_state_t.hpp"
 
 namespace stewart {
 
@@ -29,6 +33,8 @@ class EstimatorNode {
   void OnCommand(const lcm::ReceiveBuffer* rbuf, const std::string& channel,
                  const force_command_t* msg);
   void OnTruth(const lcm::ReceiveBuffer* rbuf, const std::string& channel, const state_t* msg);
+  void OnSupervisor(const lcm::ReceiveBuffer* rbuf, const std::string& channel,
+                    const supervisor_state_t* msg);
 
   HealthReporter& health() { return health_; }
 
@@ -39,6 +45,7 @@ class EstimatorNode {
   lcm::LCM* lcm_;
   LcmReceiver receiver_;
   HealthReporter health_;
+  MessageAuthenticator auth_;
   EstimatorProcess process_;
   state_t state_msg_{};
 };

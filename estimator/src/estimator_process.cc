@@ -23,16 +23,27 @@ StateSample StateFromEstimate(const Estimate& estimate, int64_t seq) {
 EstimatorProcess::EstimatorProcess(const PlatformParams& platform, const ActuatorConfig& actuators,
                                    const SensorConfig& sensors, const EstimatorConfig& estimator,
                                    const Vector6d& home_pose, HealthCounters* counters,
-                                   const TimePlausibilityParams& time)
+                                   const TimePlausibilityParams& time,
+                                   std::optional<SafeCommandAcceptorLimits> trust)
     : ekf_(platform, actuators, sensors, estimator, home_pose),
       counters_(counters),
       time_check_(time, estimator.perfect_state ? "truth" : "sensor", estimator.max_dt_s,
                   counters) {
+  if (trust) acceptor_.emplace(*trust);
   STEWART_CHECK(counters_ != nullptr, "EstimatorProcess needs its counters");
 }
 
+AnnouncementVerdict EstimatorProcess::OnAnnouncement(const SessionAnnouncement& announcement,
+                                                     bool authentic, int64_t wall_us) {
+  if (!acceptor_) return AnnouncementVerdict::kAdopted;
+  counters_->CountIn();
+  const AnnouncementVerdict verdict = acceptor_->OnAnnouncement(announcement, authentic, wall_us);
+  if (IsRejection(verdict)) counters_->Reject(ToString(verdict));
+  return verdict;
+}
+
 void EstimatorProcess::OnCommand(const ForceCommand& command,
-                                 std::optional<int64_t> receive_wall_us) {
+                                 std::optional<int64_t> receive_wall_us, bool authentic) {
   counters_->CountIn();
   // A command's sample_utime is the sample it answers: the EKF files it
   // under that time, so a far-off one would act on every later prediction.
@@ -42,6 +53,13 @@ void EstimatorProcess::OnCommand(const ForceCommand& command,
   if (!command.force_n.allFinite()) {
     counters_->Reject("command_non_finite");
     return;
+  }
+  if (acceptor_) {
+    const CommandRejection rejection = acceptor_->Check(command, authentic);
+    if (rejection != CommandRejection::kNone) {
+      counters_->Reject(ToString(rejection));
+      return;
+    }
   }
   ekf_.SetForceCommand(command.sample_utime, command.force_n,
                        (command.flags & kCommandDriveOff) != 0);
@@ -53,6 +71,11 @@ bool EstimatorProcess::OnSensor(const SensorSample& sample, StateSample* out,
   // Before the EKF: a sample far ahead would restart it at that time (a gap
   // over max_dt_s) and every real sample after it would be out of order.
   if (!time_check_.CheckSource(sample.utime, sample.utime, receive_wall_us)) return false;
+  // The acceptor judges a command's age against the newest sample, as the
+  // plant judges it against the newest it published.
+  if (acceptor_ && sample.utime >= acceptor_->newest_sample_utime()) {
+    acceptor_->OnSamplePublished(sample.utime);
+  }
   const UpdateResult result = ekf_.Update(sample);
   if (result.Has(kRejectTime)) {
     time_check_.SourceRejected(sample.utime, receive_wall_us);

@@ -8,40 +8,30 @@
 namespace stewart {
 
 OperatorResetFilter::OperatorResetFilter(MessageAuthenticator auth, double window_s)
-    : auth_(std::move(auth)), window_us_(std::llround(window_s * 1e6)) {}
+    : auth_(std::move(auth)), check_(std::llround(window_s * 1e6)) {}
 
 bool OperatorResetFilter::OnCommand(const operator_command_t& msg, int64_t receive_wall_us) {
   if (msg.command != operator_command_t::COMMAND_RESET) return false;
-  if (msg.operator_id == 0) {  // never a console's id
-    ++counts_.rejected_invalid;
-    return false;
+  // Both clocks are wall clocks here (the operator's console and this host),
+  // so the bus's time window bounds their difference.
+  switch (check_.Check(msg.operator_id, msg.seq, msg.utime, auth_.Verify(msg), receive_wall_us)) {
+    case OperatorVerdict::kAccepted:
+      ++counts_.accepted;
+      return true;
+    case OperatorVerdict::kUnauthentic:
+      ++counts_.rejected_auth;
+      return false;
+    case OperatorVerdict::kZeroOperator:
+      ++counts_.rejected_invalid;
+      return false;
+    case OperatorVerdict::kStale:
+      ++counts_.rejected_time;
+      return false;
+    case OperatorVerdict::kSeqNotIncreasing:
+      ++counts_.rejected_replay;
+      return false;
   }
-  if (!auth_.Verify(msg)) {
-    ++counts_.rejected_auth;
-    return false;
-  }
-  // Both are wall clocks here (the operator's console and this host), so
-  // the bus's window bounds their difference.
-  if (msg.utime < receive_wall_us - window_us_ || msg.utime > receive_wall_us + window_us_) {
-    ++counts_.rejected_time;
-    return false;
-  }
-  OperatorSeq* slot = nullptr;
-  for (OperatorSeq& s : last_seq_) {
-    if (s.operator_id == msg.operator_id) slot = &s;
-  }
-  if (slot != nullptr && msg.seq <= slot->seq) {
-    ++counts_.rejected_replay;
-    return false;
-  }
-  if (slot == nullptr) {
-    slot = &last_seq_[next_slot_];
-    next_slot_ = (next_slot_ + 1) % last_seq_.size();
-    slot->operator_id = msg.operator_id;
-  }
-  slot->seq = msg.seq;
-  ++counts_.accepted;
-  return true;
+  return false;
 }
 
 OperatorResets::OperatorResets(const LcmConfig& lcm)

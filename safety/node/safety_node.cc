@@ -30,7 +30,6 @@ int64_t NewSessionId() {
 
 constexpr int64_t kAnnounceStackUs = 100'000;
 constexpr int64_t kAnnounceWallUs = 500'000;
-constexpr size_t kMaxOperators = 64;
 
 }  // namespace
 
@@ -45,7 +44,8 @@ SafetyNode::SafetyNode(const StackConfig& config, lcm::LCM* lcm,
       auth_(MessageAuthenticator::FromKeyFile(config.lcm.auth_key_file)),
       monitor_(config.supervisor.required_processes,
                std::llround(config.supervisor.heartbeat_timeout_s * 1e6)),
-      session_id_(NewSessionId()) {
+      session_id_(NewSessionId()),
+      operator_check_(std::llround(config.supervisor.operator_time_window_s * 1e6)) {
   receiver_.Subscribe(config.lcm.channels.state_estimate, &SafetyNode::OnState, this);
   receiver_.Subscribe(config.lcm.channels.command_nominal, &SafetyNode::OnNominal, this);
   receiver_.Subscribe(config.lcm.channels.operator_command, &SafetyNode::OnOperator, this);
@@ -72,28 +72,17 @@ void SafetyNode::OnOperator(const lcm::ReceiveBuffer*, const std::string&,
     health_.Reject(counter, why);
     spdlog::warn("safety: operator command rejected: {}", why);
   };
-  // Who sent it and when, before what it asks.
-  if (!auth_.Verify(*msg))
-    return reject("operator_bad_mac", "operator command: MAC does not verify");
-  if (msg->operator_id == 0)
-    return reject("operator_no_id", "operator command without operator_id");
+  // Who sent it and when, before what it asks: the actuators' rule (MAC,
+  // wall-clock window, seq per console).
   const int64_t now_us = WallUs();
-  const int64_t window_us = std::llround(config_.supervisor.operator_time_window_s * 1e6);
-  if (std::llabs(msg->utime - now_us) > window_us) {
-    return reject("operator_stale", "operator command " +
-                                        std::to_string((msg->utime - now_us) / 1000) +
-                                        " ms from this host's clock (window " +
-                                        std::to_string(window_us / 1000) + " ms)");
+  const OperatorVerdict verdict =
+      operator_check_.Check(msg->operator_id, msg->seq, msg->utime, auth_.Verify(*msg), now_us);
+  if (verdict != OperatorVerdict::kAccepted) {
+    return reject(ToString(verdict), "operator command from " + std::to_string(msg->operator_id) +
+                                         ", seq " + std::to_string(msg->seq) + ", " +
+                                         std::to_string((msg->utime - now_us) / 1000) +
+                                         " ms from this host's clock");
   }
-  auto it = operator_seq_.find(msg->operator_id);
-  if (it != operator_seq_.end() && msg->seq <= it->second) {
-    return reject("operator_replayed", "operator command seq " + std::to_string(msg->seq) +
-                                           " not after " + std::to_string(it->second));
-  }
-  if (it == operator_seq_.end() && operator_seq_.size() >= kMaxOperators) {
-    operator_seq_.erase(operator_seq_.begin());
-  }
-  operator_seq_[msg->operator_id] = msg->seq;
   last_operator_wall_us_ = now_us;
   deadman_reported_ = false;
   if (msg->command < static_cast<int8_t>(OperatorCommand::kArm) ||

@@ -7,11 +7,11 @@
 // publishes.
 #include <cstdint>
 #include <lcm/lcm-cpp.hpp>
-#include <map>
 #include <string>
 
 #include "stewart/config/stack_config.h"
 #include "stewart/force_command_t.hpp"
+#include "stewart/guard/operator_command_check.h"
 #include "stewart/health_t.hpp"
 #include "stewart/node/exit_code.h"
 #include "stewart/node/health_reporter.h"
@@ -58,6 +58,7 @@ class SafetyNode {
   MessageAuthenticator auth_;
   safety::ProcessMonitor monitor_;
   const int64_t session_id_;
+  OperatorCommandCheck operator_check_;
   force_command_t command_{};
   safety_diagnostics_t diagnostics_msg_{};
   supervisor_state_t supervisor_msg_{};
@@ -68,7 +69,6 @@ class SafetyNode {
   int64_t announced_transitions_ = -1;
   int64_t last_operator_wall_us_ = 0;  // dead-man
   bool deadman_reported_ = false;
-  std::map<int64_t, int64_t> operator_seq_;  // operator_id -> newest seq accepted
   int64_t operator_accepted_ = 0;
   int64_t operator_rejected_ = 0;
   int64_t last_operator_id_ = 0;

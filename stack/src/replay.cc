@@ -1,5 +1,7 @@
 #include "stewart/stack/replay.h"
 
+#include <spdlog/spdlog.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -12,7 +14,9 @@
 #include "stewart/common/health_counters.h"
 #include "stewart/controller/controller_process.h"
 #include "stewart/estimator/estimator_process.h"
+#include "stewart/guard/guard_limits.h"
 #include "stewart/node/eigen_msg.h"
+#include "stewart/node/message_auth.h"
 #include "stewart/node/signal_messages.h"
 #include "stewart/safety/diagnostics_lcm.h"
 #include "stewart/safety/process_monitor.h"
@@ -21,6 +25,19 @@
 
 namespace stewart::replay {
 namespace {
+
+/// The run's key (lcm.auth_key_file of its config.yaml) to recheck recorded
+/// MACs as the live processes checked them. A run folder whose key is gone
+/// (moved, or the key deleted) replays believing every recorded message, and
+/// says so: forged commands in such a log would be believed here, not live.
+MessageAuthenticator RecordedRunAuthenticator(const StackConfig& config) {
+  try {
+    return MessageAuthenticator::FromKeyFile(config.lcm.auth_key_file);
+  } catch (const std::exception& e) {
+    spdlog::warn("replay: {}; recorded messages are believed without their MACs", e.what());
+    return MessageAuthenticator();
+  }
+}
 
 template <typename Msg>
 bool Decode(const lcm::LogEvent& event, Msg* msg) {
@@ -557,8 +574,12 @@ EstimatorReplayResult ReplayEstimator(const StackConfig& config, const RecordedL
   }
   Pairing<state_t> recorded_estimates(log.estimates, &r.estimates);
   HealthCounters counters("estimator replay");
+  // The live estimator believes the safe commands the actuators would apply
+  // (the announced session, its MAC): replay decides the same from the log.
   EstimatorProcess process(config.platform, config.actuators, config.sensors, config.estimator,
-                           config.home_pose, &counters, config.lcm.time_plausibility);
+                           config.home_pose, &counters, config.lcm.time_plausibility,
+                           AcceptorLimitsOf(config.guard, config.estimator.command_timeout_s));
+  MessageAuthenticator auth = RecordedRunAuthenticator(config);
   auto compare = [&](const StateSample& sample) {
     state_t replayed{};
     ToMessage(sample, &replayed);
@@ -580,13 +601,19 @@ EstimatorReplayResult ReplayEstimator(const StackConfig& config, const RecordedL
       if (process.OnTruth(FromMessage(truth), &state)) compare(state);
     }
   } else {
-    // EstimatorProcess::OnCommand / OnSensor, in the order the log received them.
-    for (const auto& [channel, index] : log.order) {
-      if (channel == Channel::kCommandSafe) {
+    // EstimatorProcess::OnAnnouncement / OnCommand / OnSensor, in the order
+    // the log received them (the logger's receive time as the wall clock).
+    for (size_t e = 0; e < log.order.size(); ++e) {
+      const auto& [channel, index] = log.order[e];
+      if (channel == Channel::kSupervisor) {
+        const supervisor_state_t& sup = log.supervisor[static_cast<size_t>(index)];
+        process.OnAnnouncement(SessionAnnouncement{sup.utime, sup.seq, sup.session_id},
+                               auth.Verify(sup), log.order_timestamp_us[e]);
+      } else if (channel == Channel::kCommandSafe) {
         const force_command_t& command = log.safe[static_cast<size_t>(index)];
         ++r.commands;
         if (!AllFinite(command.force_n)) ++r.rejected_commands;
-        process.OnCommand(FromMessage(command));
+        process.OnCommand(FromMessage(command), std::nullopt, auth.Verify(command));
       } else if (channel == Channel::kSensors) {
         ++r.sensor_samples;
         StateSample state;

@@ -20,6 +20,7 @@
 #include "stewart/node/lcm_handle.h"
 #include "stewart/sensor_t.hpp"
 #include "stewart/state_t.hpp"
+#include "stewart/supervisor_state_t.hpp"
 #include "stewart/test_support/child_process.h"
 #include "stewart/test_support/lcm_messages.h"
 
@@ -99,6 +100,11 @@ TEST_F(EstimatorProcess, EstimatesCarryTheSensorSampleUtime) {
   std::map<int64_t, TruthState> published;
   TruthSample previous;
   int64_t seq = 0;
+  // The safety session the actuators follow, announced every 50 samples;
+  // every 25th sample a forger publishes 50 N per leg under another session
+  // (the plant drops those: the estimate must not believe them either).
+  constexpr int64_t kSession = 4242;
+  int forgeries = 0;
   for (int k = 0; k < kSamples; ++k) {
     const TruthSample t = truth.Next();
     if (k > 0) {
@@ -106,12 +112,28 @@ TEST_F(EstimatorProcess, EstimatesCarryTheSensorSampleUtime) {
       cmd.utime = previous.utime;
       cmd.seq = k - 1;
       cmd.sample_utime = previous.utime;
+      cmd.session_id = kSession;
       for (int i = 0; i < 6; ++i) cmd.force_n[i] = previous.force_n(i);
+      if (k % 25 == 0) {
+        force_command_t forged = cmd;
+        forged.session_id = kSession + 1;
+        forged.seq = 1'000'000 + k;
+        for (int i = 0; i < 6; ++i) forged.force_n[i] = 50.0;
+        lcm->publish(ch.command_safe, &forged);
+        ++forgeries;
+      }
       lcm->publish(ch.command_safe, &cmd);
     }
     sensor_t msg = ToMessage(t.sensors, seq++);
     if (k == kNanSample) msg.leg_length_m[1] = NAN;
     lcm->publish(ch.sensors, &msg);
+    if (k % 50 == 0) {
+      supervisor_state_t announcement{};
+      announcement.utime = t.utime;
+      announcement.seq = k / 50 + 1;
+      announcement.session_id = kSession;
+      lcm->publish(ch.supervisor, &announcement);
+    }
     published[t.utime] = t.state;
     if (k == kNanSample) {
       lcm->publish(ch.sensors, &msg);  // a duplicate: rejected, no estimate
@@ -142,18 +164,20 @@ TEST_F(EstimatorProcess, EstimatesCarryTheSensorSampleUtime) {
     EXPECT_GT(last.q_std[j], 0.0);
     EXPECT_LT(last.q_std[j], 2e-4);
   }
-  // Health: the NaN legs and the duplicate are counted rejections.
   ASSERT_TRUE(HandleUntil(
-      lcm.get(), [&] { return sink.health.back().messages_in >= 2 * kSamples; }, 5.0));
+      lcm.get(), [&] { return sink.health.back().messages_in >= 2 * kSamples + forgeries; }, 5.0));
   const health_t& h = sink.health.back();
   std::string counters;
   for (int i = 0; i < h.num_counters; ++i) {
     counters += h.counter_names[static_cast<size_t>(i)] + "=" +
                 std::to_string(h.counter_values[static_cast<size_t>(i)]) + " ";
   }
-  EXPECT_EQ(h.rejected_inputs, 2) << counters;
+  // Health: the NaN legs, the duplicate and the forgeries are counted
+  // rejections; every command of the announced session was believed.
+  EXPECT_EQ(h.rejected_inputs, 2 + forgeries) << counters;
   EXPECT_EQ(Counter(h, "rejected_legs_non_finite"), 1);
   EXPECT_EQ(Counter(h, "rejected_non_increasing_time"), 1);
+  EXPECT_EQ(Counter(h, "rejected_command_wrong_session"), forgeries) << counters;
   EXPECT_EQ(h.messages_out, kSamples);
   EXPECT_EQ(proc->Stop(SIGTERM), 0);
 }

@@ -11,10 +11,8 @@
 //
 // LCM port 7922 (this folder owns 7920-7939). It holds the launcher lock
 // of the build folder, as the launched-stack tests do.
-#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <signal.h>
-#include <sys/file.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -34,6 +32,7 @@
 #include "stewart/state_t.hpp"
 #include "stewart/test_support/child_process.h"
 #include "stewart/test_support/recorded_run.h"
+#include "stewart/test_support/stack_launch.h"
 
 namespace stewart {
 namespace {
@@ -63,25 +62,12 @@ struct Bus {
   std::map<std::string, health_t> health;
 };
 
-class LauncherLock {
- public:
-  LauncherLock() : fd_(open(STEWART_BUILD_DIR "/stack_launch.lock", O_CREAT | O_RDWR, 0644)) {
-    if (fd_ >= 0) flock(fd_, LOCK_EX);
-  }
-  ~LauncherLock() {
-    if (fd_ >= 0) close(fd_);
-  }
-
- private:
-  int fd_;
-};
-
 // With the per-period bound as shipped, and (the before) switched off.
 class ForgedNominalStack : public ::testing::TestWithParam<bool> {};
 
 TEST_P(ForgedNominalStack, MillionNewtonNominalsForTheNextSample) {
   const bool bound = GetParam();
-  LauncherLock lock;
+  test::LauncherLock lock;
   std::string folder = "/tmp/stewart_forged_nominal_XXXXXX";
   ASSERT_NE(mkdtemp(folder.data()), nullptr);
   const std::string log_path = folder + "/log.lcm";

@@ -17,11 +17,9 @@
 // LCM port 7920 (this folder owns 7920-7939). It holds the launcher lock
 // of the build folder, as the launched-stack tests do, so two stacks never
 // share the 2 cores.
-#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <stdlib.h>
-#include <sys/file.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -42,6 +40,7 @@
 #include "stewart/state_t.hpp"
 #include "stewart/test_support/child_process.h"
 #include "stewart/test_support/recorded_run.h"
+#include "stewart/test_support/stack_launch.h"
 
 namespace stewart {
 namespace {
@@ -88,22 +87,8 @@ struct Bus {
   std::map<std::string, std::string> latched;
 };
 
-/// The launcher lock of the build folder (tests/support/stack_launch.cc).
-class LauncherLock {
- public:
-  LauncherLock() : fd_(open(STEWART_BUILD_DIR "/stack_launch.lock", O_CREAT | O_RDWR, 0644)) {
-    if (fd_ >= 0) flock(fd_, LOCK_EX);
-  }
-  ~LauncherLock() {
-    if (fd_ >= 0) close(fd_);  // releases the lock
-  }
-
- private:
-  int fd_;
-};
-
 TEST(ForgedTimeStack, LockstepRunSurvivesForgedTimesAndTheWatchdogStillFires) {
-  LauncherLock lock;
+  test::LauncherLock lock;
   std::string folder = "/tmp/stewart_forged_time_XXXXXX";
   ASSERT_NE(mkdtemp(folder.data()), nullptr);
   const std::string log_path = folder + "/log.lcm";

@@ -221,12 +221,13 @@ TEST_P(ActuatorTrustAttack, ForgedCommandsAreDroppedAndTheLimitsHold) {
   EXPECT_LE(Counter(bus.plant, "commands_trusted"), bus.real_commands);
   EXPECT_GE(Counter(bus.plant, "commands_trusted"), bus.real_commands - 700);
   EXPECT_EQ(Counter(bus.plant, "sessions_adopted"), 1);
-  // Not asserted: the estimator still takes every CMD_SAFE as the force
-  // acting, forged ones included, so its estimate goes wrong and the filter
-  // may then command beyond guard.leg_force_limit_n: plant_sim's guard trips
-  // and holds the platform (seen: leg 0 at -21.3 N). That is the last line
-  // working; the estimator following the same SafeCommandAcceptor would
-  // keep the run going.
+  // The estimator believes only what the plant applies: it counts the same
+  // forgeries, its estimate stays right, and the filter never commands
+  // beyond guard.leg_force_limit_n (before, believing every CMD_SAFE, it did:
+  // leg 0 at -21.3 N, and plant_sim's guard had to hold the platform).
+  ASSERT_FALSE(bus.estimator.empty());
+  EXPECT_GE(Counter(bus.estimator.back(), c.counter), bus.forged - 50) << c.counter;
+  EXPECT_EQ(Counter(bus.plant, "guard_trips"), 0);
   std::printf("[trust] plant_sim: %s; estimator: %s\n", bus.plant.last_error.c_str(),
               bus.estimator.empty() ? "-" : bus.estimator.back().last_error.c_str());
   std::printf("[trust] %s%s: %ld forgeries, %lld dropped as %s, guard trips %lld\n",

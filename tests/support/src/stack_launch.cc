@@ -1,6 +1,9 @@
 #include "stewart/test_support/stack_launch.h"
 
+#include <fcntl.h>
+#include <sys/file.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <chrono>
 #include <cstdlib>
@@ -10,6 +13,15 @@
 #include "stewart/node/lcm_handle.h"
 
 namespace stewart::test {
+
+LauncherLock::LauncherLock()
+    : fd_(open(STEWART_BUILD_DIR "/stack_launch.lock", O_CREAT | O_RDWR, 0644)) {
+  if (fd_ >= 0) flock(fd_, LOCK_EX);
+}
+
+LauncherLock::~LauncherLock() {
+  if (fd_ >= 0) close(fd_);  // releases the lock
+}
 
 std::string ShellQuote(const std::string& s) {
   std::string quoted = "'";

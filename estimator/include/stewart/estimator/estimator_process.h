@@ -11,6 +11,7 @@
 #include "stewart/common/input_time_check.h"
 #include "stewart/common/signals.h"
 #include "stewart/estimator/ekf.h"
+#include "stewart/guard/safe_command_acceptor.h"
 
 namespace stewart {
 
@@ -24,15 +25,27 @@ class EstimatorProcess {
   /// `time`: lcm.time_window_s, lcm.max_time_rate. A stream of samples
   /// rejected whole for longer than estimator.max_dt_s (the gap after which
   /// the EKF restarts) is a FAULT.
+  /// `trust`: believe a safe command only when the actuators would apply it
+  /// (guard/safe_command_acceptor.h: the announced safety session, its MAC,
+  /// rising seq, a fresh sample), so a forgery the plant drops cannot move
+  /// the estimate either. Absent: every finite command with a plausible time
+  /// (the in-process loop, which hands over the safety process's own output).
   EstimatorProcess(const PlatformParams& platform, const ActuatorConfig& actuators,
                    const SensorConfig& sensors, const EstimatorConfig& estimator,
                    const Vector6d& home_pose, HealthCounters* counters,
-                   const TimePlausibilityParams& time = {});
+                   const TimePlausibilityParams& time = {},
+                   std::optional<SafeCommandAcceptorLimits> trust = std::nullopt);
 
-  /// A safe command arrived: the process model's input (non-finite ones and
-  /// ones with an implausible time are rejected).
-  void OnCommand(const ForceCommand& command,
-                 std::optional<int64_t> receive_wall_us = std::nullopt);
+  /// A safety session announcement (supervisor_state_t); `authentic`: its
+  /// MAC verified (true without a key); `wall_us`: the receiver's monotonic
+  /// clock. Without `trust`, nothing to decide: kAdopted, ignored.
+  AnnouncementVerdict OnAnnouncement(const SessionAnnouncement& announcement, bool authentic,
+                                     int64_t wall_us);
+  /// A safe command arrived: the process model's input (non-finite ones,
+  /// ones with an implausible time and, with `trust`, ones the actuators
+  /// would not apply are rejected and counted).
+  void OnCommand(const ForceCommand& command, std::optional<int64_t> receive_wall_us = std::nullopt,
+                 bool authentic = true);
   /// A sensor sample arrived. Returns true when `out` holds an estimate to
   /// publish.
   bool OnSensor(const SensorSample& sample, StateSample* out,
@@ -42,6 +55,8 @@ class EstimatorProcess {
                std::optional<int64_t> receive_wall_us = std::nullopt);
 
   const Ekf& ekf() const { return ekf_; }
+  /// The acceptor of `trust` (nullptr without it).
+  const SafeCommandAcceptor* acceptor() const { return acceptor_ ? &*acceptor_ : nullptr; }
 
  private:
   /// Publishing bookkeeping: non-finite estimates are rejected, never sent.
@@ -50,6 +65,7 @@ class EstimatorProcess {
   Ekf ekf_;
   HealthCounters* counters_;
   InputTimeCheck time_check_;
+  std::optional<SafeCommandAcceptor> acceptor_;
   int64_t seq_ = 0;
 };
 

@@ -21,6 +21,7 @@
 #include <memory>
 #include <string>
 
+#include "stewart/guard/operator_command_check.h"
 #include "stewart/node/lcm_config.h"
 #include "stewart/node/lcm_receiver.h"
 #include "stewart/node/message_auth.h"
@@ -46,14 +47,8 @@ class OperatorResetFilter {
   const OperatorResetCounts& counts() const { return counts_; }
 
  private:
-  struct OperatorSeq {
-    int64_t operator_id = 0;  // 0: free (operator ids are never 0)
-    int64_t seq = 0;
-  };
   MessageAuthenticator auth_;
-  int64_t window_us_;
-  std::array<OperatorSeq, 8> last_seq_{};  // the last few operators, replaced round robin
-  size_t next_slot_ = 0;
+  OperatorCommandCheck check_;  // the actuators' rule: MAC, time window, seq per console
   OperatorResetCounts counts_;
 };
 

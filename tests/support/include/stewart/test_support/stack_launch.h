@@ -47,6 +47,20 @@ struct LaunchResult {
 LaunchResult RunLauncher(const std::string& args, int lcm_port, const std::string& run_dir,
                          const std::string& output_path);
 
+/// Holds the launcher lock of this build folder (<build>/stack_launch.lock)
+/// while a test runs a stack of its own, so that no two stacks share the 2
+/// cores (RunLauncher takes the same lock).
+class LauncherLock {
+ public:
+  LauncherLock();
+  ~LauncherLock();
+  LauncherLock(const LauncherLock&) = delete;
+  LauncherLock& operator=(const LauncherLock&) = delete;
+
+ private:
+  int fd_;
+};
+
 /// Why a launch failed, for the test's message: the exit code's meaning, the
 /// wall time and the launcher's whole output.
 std::string LaunchFailure(const LaunchResult& launch);

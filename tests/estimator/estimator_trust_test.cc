@@ -1,0 +1,137 @@
+// The estimator believes a safe command only when the actuators would apply
+// it (guard/safe_command_acceptor.h): the announced safety session, rising
+// seq, a fresh sample, a verified MAC. Before, a forged CMD_SAFE the plant
+// dropped was still the process model's input and moved the estimate.
+#include <gtest/gtest.h>
+
+#include <vector>
+
+#include "scenario_truth.h"
+#include "stewart/config/default_config.h"
+#include "stewart/estimator/estimator_process.h"
+#include "stewart/guard/guard_limits.h"
+
+namespace stewart {
+namespace {
+
+constexpr int64_t kSession = 77;
+constexpr int64_t kWallUs = 1'780'000'000'000'000;
+
+struct EstimatorRun {
+  std::vector<StateSample> estimates;
+  HealthCounters counters{"estimator"};
+};
+
+enum class Forgery { kNone, kOtherSession, kUnauthentic, kReplayedSeq };
+
+/// 1000 samples of the paper scenario, each followed by the applied command
+/// of the announced session; from sample 200, every 10th command is followed
+/// by a forged one of 30 N per leg for the same sample.
+void RunEstimator(bool trusted, Forgery forgery, EstimatorRun* run) {
+  const StackConfig& c = DefaultStackConfig();
+  test::ScenarioTruth truth(c, 3);
+  EstimatorProcess process(c.platform, c.actuators, c.sensors, c.estimator, c.home_pose,
+                           &run->counters, c.lcm.time_plausibility,
+                           trusted ? std::optional<SafeCommandAcceptorLimits>(
+                                         AcceptorLimitsOf(c.guard, c.estimator.command_timeout_s))
+                                   : std::nullopt);
+  for (int k = 0; k < 1000; ++k) {
+    const test::TruthSample sample = truth.Next();
+    StateSample out;
+    if (process.OnSensor(sample.sensors, &out)) run->estimates.push_back(out);
+    if (k % 50 == 0) {
+      EXPECT_FALSE(IsRejection(process.OnAnnouncement({sample.utime, k / 50 + 1, kSession}, true,
+                                                      kWallUs + sample.utime)));
+    }
+    ForceCommand command;
+    command.utime = command.sample_utime = sample.utime;
+    command.seq = 10 * k;
+    command.session_id = kSession;
+    command.force_n = sample.force_n;
+    process.OnCommand(command);
+    // After the real one, as a forger who copies it would: the later command
+    // for a sample is the one the process model uses.
+    if (forgery != Forgery::kNone && k >= 200 && k % 10 == 0) {
+      ForceCommand forged = command;
+      forged.force_n = Vector6d::Constant(30.0);
+      bool authentic = true;
+      switch (forgery) {
+        case Forgery::kOtherSession:
+          forged.session_id = kSession + 1;
+          break;
+        case Forgery::kUnauthentic:
+          authentic = false;
+          break;
+        case Forgery::kReplayedSeq:
+          forged.seq = command.seq - 10;
+          break;
+        case Forgery::kNone:
+          break;
+      }
+      process.OnCommand(forged, std::nullopt, authentic);
+    }
+  }
+}
+
+double MaxPositionError(const EstimatorRun& a, const EstimatorRun& b) {
+  double worst = 0.0;
+  for (size_t i = 0; i < std::min(a.estimates.size(), b.estimates.size()); ++i) {
+    worst = std::max(worst, (a.estimates[i].q - b.estimates[i].q).head<3>().cwiseAbs().maxCoeff());
+  }
+  return worst;
+}
+
+class EstimatorTrust : public ::testing::TestWithParam<Forgery> {};
+
+TEST_P(EstimatorTrust, ForgedSafeCommandsAreCountedAndLeaveTheEstimateAsWithout) {
+  EstimatorRun clean, attacked, believing;
+  RunEstimator(true, Forgery::kNone, &clean);
+  RunEstimator(true, GetParam(), &attacked);
+  ASSERT_EQ(attacked.estimates.size(), clean.estimates.size());
+  for (size_t i = 0; i < clean.estimates.size(); ++i) {
+    ASSERT_EQ(attacked.estimates[i].q, clean.estimates[i].q) << i;
+    ASSERT_EQ(attacked.estimates[i].qd, clean.estimates[i].qd) << i;
+  }
+  EXPECT_EQ(attacked.counters.rejected_inputs(), clean.counters.rejected_inputs() + 80);
+  const char* counter = GetParam() == Forgery::kOtherSession ? "rejected_command_wrong_session"
+                        : GetParam() == Forgery::kUnauthentic
+                            ? "rejected_command_unauthentic"
+                            : "rejected_command_seq_not_increasing";
+  EXPECT_EQ(attacked.counters.counter(counter), 80);
+  // The before: a process that believes every finite command is moved by them.
+  RunEstimator(false, GetParam(), &believing);
+  EXPECT_GT(MaxPositionError(believing, clean), 1e-4);
+}
+
+INSTANTIATE_TEST_SUITE_P(Forgeries, EstimatorTrust,
+                         ::testing::Values(Forgery::kOtherSession, Forgery::kUnauthentic,
+                                           Forgery::kReplayedSeq));
+
+TEST(EstimatorTrust, CommandsBeforeAnyAnnouncementAreNotBelieved) {
+  const StackConfig& c = DefaultStackConfig();
+  test::ScenarioTruth truth(c, 3);
+  HealthCounters counters{"estimator"};
+  EstimatorProcess process(c.platform, c.actuators, c.sensors, c.estimator, c.home_pose, &counters,
+                           c.lcm.time_plausibility,
+                           AcceptorLimitsOf(c.guard, c.estimator.command_timeout_s));
+  const test::TruthSample sample = truth.Next();
+  StateSample out;
+  process.OnSensor(sample.sensors, &out);
+  ForceCommand command;
+  command.utime = command.sample_utime = sample.utime;
+  command.session_id = kSession;
+  command.force_n = sample.force_n;
+  process.OnCommand(command);
+  EXPECT_EQ(counters.counter("rejected_command_no_session"), 1);
+  EXPECT_EQ(process.OnAnnouncement({sample.utime + 1000, 1, kSession}, true, kWallUs),
+            AnnouncementVerdict::kFuture);
+  EXPECT_EQ(process.OnAnnouncement({sample.utime, 1, kSession}, true, kWallUs),
+            AnnouncementVerdict::kAdopted);
+  command.seq = 1;
+  process.OnCommand(command);
+  EXPECT_EQ(counters.rejected_inputs(), 2);  // the command and the announcement from the future
+  EXPECT_EQ(process.acceptor()->accepted(), 1);
+}
+
+}  // namespace
+}  // namespace stewart
