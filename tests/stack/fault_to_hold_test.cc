@@ -110,7 +110,19 @@ struct Times {
   std::optional<double> stop_stack_ms, stop_wall_ms;
   std::optional<double> hold_stack_ms, hold_wall_ms;
   std::string hold_reason;
+  // Messages the test did not receive (gaps in seq): a measure may be late.
+  int64_t lost_sensors = 0, lost_safe = 0, lost_supervisor = 0;
 };
+
+template <typename Msg>
+int64_t Lost(const std::vector<Received<Msg>>& received) {
+  int64_t lost = 0;
+  for (size_t i = 1; i < received.size(); ++i) {
+    const int64_t step = received[i].msg.seq - received[i - 1].msg.seq;
+    if (step > 1) lost += step - 1;
+  }
+  return lost;
+}
 
 std::string Ms(const std::optional<double>& v) {
   if (!v) return "never";
@@ -249,6 +261,9 @@ class Stack {
         break;
       }
     }
+    t.lost_sensors = Lost(bus.sensors);
+    t.lost_safe = Lost(bus.safe);
+    t.lost_supervisor = Lost(bus.supervisor);
     return t;
   }
 
@@ -279,6 +294,13 @@ void Print(const char* fault, const Times& t, const std::string& extra = "") {
       "[fault-to-hold] %-22s safe stop %s stack / %s wall; HOLD %s stack / %s wall (%s)%s%s\n",
       fault, Ms(t.stop_stack_ms).c_str(), Ms(t.stop_wall_ms).c_str(), Ms(t.hold_stack_ms).c_str(),
       Ms(t.hold_wall_ms).c_str(), t.hold_reason.c_str(), extra.empty() ? "" : "; ", extra.c_str());
+  if (t.lost_sensors + t.lost_safe + t.lost_supervisor > 0) {
+    std::printf(
+        "[fault-to-hold]   (not received: %lld sensor samples, %lld safe commands, %lld "
+        "supervisor states)\n",
+        static_cast<long long>(t.lost_sensors), static_cast<long long>(t.lost_safe),
+        static_cast<long long>(t.lost_supervisor));
+  }
   std::fflush(stdout);
 }
 
@@ -543,7 +565,7 @@ TEST(FaultToHold, ControllerSilent) {
 }
 
 /// The operator's commands, from stewart_ctl: measured from the command's
-/// arrival on the operator channel.
+/// utime (when the console sent it).
 void OperatorCommand(const char* name, int port, const char* verb, int8_t command, int8_t state) {
   LauncherLock lock;
   Stack stack(std::string("operator_") + verb, port, "");
@@ -557,7 +579,10 @@ void OperatorCommand(const char* name, int port, const char* verb, int8_t comman
   int64_t fault = -1;
   for (const auto& op : stack.bus.operators) {
     if (op.msg.command == command) {
-      fault = op.recv_us;  // the first: the console may send it again
+      // Its send time (the console's clock, this host's): the safety
+      // process can receive it, act and announce a few us before the
+      // test's own copy is timestamped.
+      fault = op.msg.utime;
       break;
     }
   }
