@@ -3,8 +3,9 @@
 // the operator's console stewart_ctl): a fresh stack per fault, armed by the
 // supervisor (auto_arm, as tools/launch.sh has it in simulation), the fault
 // injected once it is ARMED. Measured from the fault (its wall time, and the
-// stack time of the first sensor sample received after it) to
-//   (a) the first CMD_SAFE carrying FLAG_FALLBACK (the safe stop), and
+// stack time of the first sensor sample after it) to
+//   (a) the first CMD_SAFE carrying FLAG_FALLBACK of those that last (the
+//       safe stop), and
 //   (b) the first supervisor_state_t in HOLD (ESTOP for the estop).
 // Each test prints one "[fault-to-hold]" line and bounds both from the
 // config (docs/operations.md, "Arming and e-stop", the table of faults).
