@@ -126,9 +126,10 @@ void SafetyNode::Fault(const std::string& reason) {
 
 void SafetyNode::Periodic() {
   const int64_t now_us = WallUs();
+  const SupervisorState s = process_.supervisor().state();
+  monitor_.SetMoving(s == SupervisorState::kArming || s == SupervisorState::kArmed, now_us);
   for (const std::string& fault : monitor_.CheckSilence(now_us)) Fault(fault);
   const double deadman_s = config_.supervisor.operator_timeout_s;
-  const SupervisorState s = process_.supervisor().state();
   if (deadman_s > 0.0 && !deadman_reported_ &&
       (s == SupervisorState::kArming || s == SupervisorState::kArmed) &&
       now_us - last_operator_wall_us_ > std::llround(deadman_s * 1e6)) {

@@ -21,6 +21,13 @@ ProcessMonitor::ProcessMonitor(const std::vector<std::string>& required, int64_t
     }
     ++groups_;
   }
+  unheard_reported_.assign(groups_, false);
+}
+
+void ProcessMonitor::SetMoving(bool moving, int64_t wall_us) {
+  if (moving && !moving_) moving_since_us_ = wall_us;
+  if (!moving) unheard_reported_.assign(groups_, false);
+  moving_ = moving;
 }
 
 std::string ProcessMonitor::OnHeartbeat(const std::string& name, int8_t state, int64_t seq,
@@ -48,6 +55,19 @@ std::vector<std::string> ProcessMonitor::CheckSilence(int64_t wall_us) {
     if (!p.seen || p.silent_reported || wall_us - p.wall_us <= timeout_us_) continue;
     p.silent_reported = true;
     faults.push_back(p.name + " heartbeat lost");
+  }
+  if (!moving_ || wall_us - moving_since_us_ <= timeout_us_) return faults;
+  for (size_t g = 0; g < groups_; ++g) {
+    bool heard = false;
+    std::string names;
+    for (const Process& p : processes_) {
+      if (p.group != g) continue;
+      heard = heard || p.seen;
+      names += (names.empty() ? "" : " or ") + p.name;
+    }
+    if (heard || unheard_reported_[g]) continue;
+    unheard_reported_[g] = true;
+    faults.push_back("no heartbeat from " + names + " since the platform started moving");
   }
   return faults;
 }

@@ -390,6 +390,10 @@ SafetyReplayResult ReplaySafety(const StackConfig& config, const RecordedLog& lo
   for (size_t e = 0; e < log.order.size(); ++e) {
     const auto& [channel, index] = log.order[e];
     const int64_t timestamp_us = log.order_timestamp_us[e];
+    const safety::SupervisorState state = process.supervisor().state();
+    monitor.SetMoving(
+        state == safety::SupervisorState::kArming || state == safety::SupervisorState::kArmed,
+        timestamp_us);
     for (const std::string& fault : monitor.CheckSilence(timestamp_us)) {
       process.supervisor().OnFault(fault);
     }

@@ -243,5 +243,40 @@ TEST(ProcessMonitor, RequiredProcessesAlternativesRestartsFaultsAndSilence) {
   EXPECT_FALSE(m.Healthy(1'300'000, &why));
 }
 
+// A process never heard from at all (stopped before its first heartbeat, or
+// its first missed while safety started) is silent too once the platform
+// has moved for the timeout; before, it was never judged, and an auto-armed
+// platform relied on the nominal watchdog alone.
+TEST(ProcessMonitor, ARequirementNeverHeardFromIsSilentOnceMoving) {
+  ProcessMonitor m({"estimator", "controller", "plant_sim|hw_bridge"}, 1'000'000);
+  EXPECT_EQ(m.OnHeartbeat("estimator", 1, 0, 0), "");
+  EXPECT_EQ(m.OnHeartbeat("plant_sim", 1, 0, 0), "");
+  EXPECT_TRUE(m.CheckSilence(5'000'000).size() == 2u);  // both seen at 0: lost
+  m.SetMoving(true, 5'000'000);
+  EXPECT_EQ(m.OnHeartbeat("estimator", 1, 1, 5'500'000), "");
+  EXPECT_EQ(m.OnHeartbeat("plant_sim", 1, 1, 5'500'000), "");
+  EXPECT_TRUE(m.CheckSilence(5'900'000).empty());  // moving for less than the timeout
+  const std::vector<std::string> unheard = m.CheckSilence(6'100'000);
+  ASSERT_EQ(unheard.size(), 1u);
+  EXPECT_EQ(unheard[0], "no heartbeat from controller since the platform started moving");
+  EXPECT_TRUE(m.CheckSilence(6'200'000).empty());  // once
+  // Held, then moving again: judged again, from the new start.
+  m.SetMoving(false, 6'300'000);
+  m.SetMoving(true, 7'000'000);
+  for (const char* alive : {"estimator", "plant_sim"}) {
+    EXPECT_EQ(m.OnHeartbeat(alive, 1, 2, 7'400'000), "");
+  }
+  EXPECT_TRUE(m.CheckSilence(7'500'000).empty());
+  EXPECT_EQ(m.CheckSilence(8'100'000).size(), 1u);
+  // Heard from: no longer.
+  m.SetMoving(false, 8'200'000);
+  EXPECT_EQ(m.OnHeartbeat("controller", 1, 0, 8'300'000), "");
+  m.SetMoving(true, 8'300'000);
+  for (const char* alive : {"estimator", "plant_sim", "controller"}) {
+    EXPECT_EQ(m.OnHeartbeat(alive, 1, 3, 9'000'000), "");
+  }
+  EXPECT_TRUE(m.CheckSilence(9'500'000).empty());
+}
+
 }  // namespace
 }  // namespace stewart::safety::test

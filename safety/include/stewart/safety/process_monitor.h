@@ -23,9 +23,17 @@ class ProcessMonitor {
   /// seen. Heartbeats of processes that are not required are ignored.
   std::string OnHeartbeat(const std::string& name, int8_t state, int64_t seq, int64_t wall_us);
 
+  /// Whether the supervisor lets the platform move (ARMING or ARMED), as of
+  /// `wall_us`. A platform can move before every required process has been
+  /// heard from (auto_arm does not wait for heartbeats, and a heartbeat can
+  /// be missed while the receiver starts): see CheckSilence.
+  void SetMoving(bool moving, int64_t wall_us);
+
   /// Silence check at `wall_us`: a fault description for each required
-  /// process seen before whose heartbeat is older than the timeout (each
-  /// reported once per silence).
+  /// process seen before whose heartbeat is older than the timeout, and for
+  /// each requirement none of whose processes was ever heard from once the
+  /// platform has been moving for the timeout (each reported once per
+  /// silence).
   std::vector<std::string> CheckSilence(int64_t wall_us);
 
   /// Every required process (one of each alternative) sent a recent
@@ -46,6 +54,9 @@ class ProcessMonitor {
   std::vector<Process> processes_;
   size_t groups_ = 0;
   int64_t timeout_us_;
+  bool moving_ = false;
+  int64_t moving_since_us_ = 0;
+  std::vector<bool> unheard_reported_;  // per requirement, while moving
 };
 
 }  // namespace stewart::safety
