@@ -228,6 +228,10 @@ void SafetyFilter::FinishStep(const Vector6d& f_des, SafetyDiagnostics* d) {
   if (d->barriers.outside_safe_set) d->flags |= kFlagOutsideSafeSet;
   const Vector6d correction = d->f_safe - f_des;
   d->correction_norm = correction.allFinite() ? correction.norm() : 0.0;
+  // A rejected F_des near the double range (1e300 N) overflows the sum of
+  // squares; the scaled norm keeps the diagnostics finite (never Inf on a
+  // channel), and costs nothing on the steps that do not need it.
+  if (std::isinf(d->correction_norm)) d->correction_norm = correction.stableNorm();
   if (!(d->correction_norm == 0.0)) d->flags |= kFlagFilterActive;
   if (d->infeasible) d->flags |= kFlagInfeasible;
 }

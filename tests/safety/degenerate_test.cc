@@ -204,6 +204,9 @@ TEST(Degenerate, HugeNominalForce) {
   EXPECT_TRUE(f.allFinite());
   EXPECT_TRUE(d.flags & kFlagInvalidInput);
   EXPECT_LT(f.norm(), 1e3);
+  // Its correction is huge and finite (the plain norm overflowed to Inf).
+  EXPECT_TRUE(std::isfinite(d.correction_norm));
+  EXPECT_GT(d.correction_norm, 2e300);
 }
 
 TEST(Degenerate, ForceLimitsThatMakeTheConditionsInfeasibleAreReported) {
