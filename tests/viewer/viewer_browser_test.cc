@@ -9,18 +9,21 @@
 #include <sys/file.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
 #include <fstream>
 #include <mutex>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <string>
 #include <thread>
 #include <unordered_map>
 #include <vector>
 
 #include "stewart/config/config_loader.h"
+#include "stewart/health_t.hpp"
 #include "stewart/node/lcm_handle.h"
 #include "stewart/node/lcm_receiver.h"
 #include "stewart/state_t.hpp"
@@ -91,8 +94,9 @@ nlohmann::json RunBrowserCheck(const std::string& mode, int http_port) {
 /// Every state estimate on the bus, by utime, received on a thread of its own.
 class EstimateRecorder {
  public:
-  EstimateRecorder(const std::string& url, const std::string& channel) : receiver_(url) {
-    receiver_.Subscribe(channel, &EstimateRecorder::On, this);
+  EstimateRecorder(const std::string& url, const ChannelNames& channels) : receiver_(url) {
+    receiver_.Subscribe(channels.state_estimate, &EstimateRecorder::On, this);
+    receiver_.Subscribe(channels.health, &EstimateRecorder::OnHealth, this);
     thread_ = std::thread([this] {
       while (!stop_) receiver_.HandleTimeout(20);
     });
@@ -112,6 +116,18 @@ class EstimateRecorder {
     const std::lock_guard<std::mutex> lock(mutex_);
     return by_utime_.size();
   }
+  /// Waits until every named process has sent a heartbeat.
+  bool WaitForHeartbeats(const std::set<std::string>& names, double timeout_s) {
+    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+    while (std::chrono::steady_clock::now() < end) {
+      {
+        const std::lock_guard<std::mutex> lock(mutex_);
+        if (std::includes(heard_.begin(), heard_.end(), names.begin(), names.end())) return true;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+    return false;
+  }
 
  private:
   void On(const lcm::ReceiveBuffer*, const std::string&, const state_t* msg) {
@@ -120,8 +136,13 @@ class EstimateRecorder {
     const std::lock_guard<std::mutex> lock(mutex_);
     by_utime_[msg->utime] = q;
   }
+  void OnHealth(const lcm::ReceiveBuffer*, const std::string&, const health_t* msg) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    heard_.insert(msg->name);
+  }
   LcmReceiver receiver_;
   std::mutex mutex_;
+  std::set<std::string> heard_;
   std::unordered_map<int64_t, std::array<double, 6>> by_utime_;
   std::atomic<bool> stop_{false};
   std::thread thread_;
@@ -136,8 +157,9 @@ std::string AutoArmOverlay(const std::string& name) {
 bool WaitForPort(int port, double timeout_s) {
   const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
   while (std::chrono::steady_clock::now() < end) {
-    const std::string cmd = "exec 3<>/dev/tcp/127.0.0.1/" + std::to_string(port) + " 2>/dev/null";
-    if (std::system(("bash -c '" + cmd + "'").c_str()) == 0) return true;
+    const std::string cmd =
+        "bash -c 'exec 3<>/dev/tcp/127.0.0.1/" + std::to_string(port) + "' 2>/dev/null";
+    if (std::system(cmd.c_str()) == 0) return true;
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
   }
   return false;
@@ -151,7 +173,7 @@ TEST(ViewerBrowser, LivePageShowsTheStateItWasSentAndKeepsUpdating) {
   constexpr int kHttpPort = 18970;
   const StackConfig config = LoadStackConfig(DefaultConfigPath());
   const std::string url = PrivateLcmUrl(kLcmPort);
-  EstimateRecorder recorder(url, config.lcm.channels.state_estimate);
+  EstimateRecorder recorder(url, config.lcm.channels);
   const std::vector<std::string> common = {
       "--lcm-url", url, "--overlay", AutoArmOverlay("viewer_auto_arm.yaml"), "--log-level", "warn"};
   auto with = [&](std::vector<std::string> head) {
