@@ -55,7 +55,7 @@ class StripChart {
       }
       g.stroke();
       g.fillStyle = ser.colour;
-      g.fillText(ser.label, 60 + 40 * k, 12);
+      g.fillText(ser.label, 170 + 30 * k, 12);  // right of the title
     });
   }
 }
