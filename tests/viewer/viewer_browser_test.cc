@@ -2,9 +2,10 @@
 // protocol, tests/viewer/browser/browser_check.js), against the lockstep
 // stack on the bus and against a recorded paper run. Chromium, node and the
 // pinned puppeteer-core are installed by tools/setup.sh; when one is
-// missing the test fails, naming it. LCM ports 7970-7971, HTTP 18970-18971.
+// missing the test fails, naming it. LCM ports 7970-7972, HTTP 18970-18972.
 #include <fcntl.h>
 #include <gtest/gtest.h>
+#include <signal.h>
 #include <stdlib.h>
 #include <sys/file.h>
 #include <unistd.h>
@@ -215,10 +216,45 @@ TEST(ViewerBrowser, LivePageShowsTheStateItWasSentAndKeepsUpdating) {
     EXPECT_GT(utime, previous_utime) << "the page stopped updating";
     previous_utime = utime;
   }
-  EXPECT_TRUE(viewer.running()) << "stewart_viewer died";
+  EXPECT_EQ(viewer.Stop(SIGTERM), 0) << "stewart_viewer did not stop cleanly";
   std::printf(
       "[viewer] live: %zu samples checked against %zu states on the bus; browser check %.1f s\n",
       samples.size(), recorder.size(), seconds);
+}
+
+TEST(ViewerBrowser, WithOperatorTheHoldButtonHoldsThePlatform) {
+  const std::string missing = MissingBrowserTools();
+  ASSERT_TRUE(missing.empty()) << "the browser test needs:" << missing << " run tools/setup.sh";
+  LauncherLock lock;
+  constexpr int kLcmPort = 7972;
+  constexpr int kHttpPort = 18972;
+  const StackConfig config = LoadStackConfig(DefaultConfigPath());
+  const std::string url = PrivateLcmUrl(kLcmPort);
+  const std::vector<std::string> common = {
+      "--lcm-url",   url,   "--overlay", AutoArmOverlay("viewer_operator_auto_arm.yaml"),
+      "--log-level", "warn"};
+  auto with = [&](std::vector<std::string> head) {
+    head.insert(head.end(), common.begin(), common.end());
+    return head;
+  };
+  test::ChildProcess viewer(with({VIEWER_PATH, "--port", std::to_string(kHttpPort), "--operator"}));
+  test::ChildProcess safety(with({SAFETY_PATH}));
+  test::ChildProcess controller(with({CONTROLLER_PATH, "--scenario", "paper"}));
+  test::ChildProcess estimator(with({ESTIMATOR_PATH}));
+  // Real time: the supervisor's answer comes while the stack runs.
+  test::ChildProcess plant(with({PLANT_SIM_PATH, "--mode", "realtime"}));
+  ASSERT_TRUE(viewer.started() && safety.started() && controller.started() && estimator.started() &&
+              plant.started());
+  ASSERT_TRUE(WaitForPort(kHttpPort, 10.0)) << "stewart_viewer did not listen on " << kHttpPort;
+  const nlohmann::json result = RunBrowserCheck("operator", kHttpPort);
+  ASSERT_TRUE(result.is_object()) << "browser_check.js wrote no result";
+  EXPECT_TRUE(result["console_errors"].empty()) << result["console_errors"].dump(1);
+  EXPECT_TRUE(result["page_errors"].empty()) << result["page_errors"].dump(1);
+  EXPECT_FALSE(result["buttons_hidden"].get<bool>()) << "no buttons with --operator";
+  EXPECT_EQ(result["supervisor"], "HOLD");
+  EXPECT_NE(result["reply"].get<std::string>().find("accepted"), std::string::npos)
+      << result["reply"];
+  EXPECT_EQ(viewer.Stop(SIGTERM), 0) << "stewart_viewer did not stop cleanly";
 }
 
 TEST(ViewerBrowser, ScrubbingARecordedPaperRunTo15sShowsTheYPhase) {
@@ -261,7 +297,7 @@ TEST(ViewerBrowser, ScrubbingARecordedPaperRunTo15sShowsTheYPhase) {
   EXPECT_NE(result["malformed_reply"].get<std::string>().find("not JSON"), std::string::npos);
   EXPECT_GT(result["after_play"]["playback"]["t_s"].get<double>(), 16.0)
       << "play at 2x did not advance";
-  EXPECT_TRUE(viewer.running()) << "stewart_viewer died";
+  EXPECT_EQ(viewer.Stop(SIGTERM), 0) << "stewart_viewer did not stop cleanly";
 }
 
 }  // namespace

@@ -125,6 +125,8 @@ int main(int argc, char** argv) {
                      server->url(),
                      flags.operator_enabled ? " (operator buttons on)" : " (read-only)");
         while (!StopRequested()) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+        // The server first: its publisher thread reads the sources until it stops.
+        server.reset();
         return ExitCode::kOk;
       });
 }

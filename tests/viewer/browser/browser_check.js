@@ -5,6 +5,7 @@
 //
 //   node browser_check.js live  URL OUT.json   samples of window.viewerState
 //   node browser_check.js scrub URL OUT.json   seek to 15 s with the slider, then play
+//   node browser_check.js operator URL OUT.json  press hold once ARMED
 'use strict';
 
 const fs = require('fs');
@@ -68,6 +69,17 @@ async function scrub(page, result) {
   result.after_play = await page.evaluate(() => ({ ...window.viewerState }));
 }
 
+async function operator(page, result) {
+  await waitFor(page, () => window.viewerState.supervisor === 'ARMED', null, 30000, 'the supervisor ARMED');
+  result.buttons_hidden = await page.$eval('#operator-buttons', (e) => e.hidden);
+  await page.click('button[data-command="hold"]');
+  await waitFor(page, () => window.viewerState.supervisor === 'HOLD', null, 10000, 'HOLD after the button');
+  await waitFor(page, () => document.getElementById('operator-reply').textContent !== '', null, 10000,
+                'the supervisor\'s reply');
+  result.reply = await page.$eval('#operator-reply', (e) => e.textContent);
+  result.supervisor = await page.evaluate(() => window.viewerState.supervisor);
+}
+
 async function main() {
   const result = { mode, console_errors: [], page_errors: [], samples: [] };
   const profile = fs.mkdtempSync(path.join(os.tmpdir(), 'stewart-viewer-chromium-'));
@@ -87,6 +99,7 @@ async function main() {
     await page.goto(url, { waitUntil: 'load', timeout: 20000 });
     if (mode === 'live') await live(page, result);
     else if (mode === 'scrub') await scrub(page, result);
+    else if (mode === 'operator') await operator(page, result);
     else throw new Error(`unknown mode ${mode}`);
     if (process.env.STEWART_VIEWER_SCREENSHOT) {
       await page.screenshot({ path: process.env.STEWART_VIEWER_SCREENSHOT });
