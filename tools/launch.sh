@@ -230,10 +230,16 @@ if ((DO_LOG)); then
 fi
 if ((SPY)); then start lcm-spy "$ROOT/tools/lcm-spy" --lcm-url="$URL"; fi
 if ((VIEWER)); then
-  # Normal scheduling, not on the loop's CPU: it only watches the bus.
+  # Normal scheduling, and off the loop's CPU when it has one: it only
+  # watches the bus.
   VIEWER_ARGS=("${COMMON[@]}")
   [[ -z $VIEWER_PORT ]] || VIEWER_ARGS+=(--port "$VIEWER_PORT")
-  start viewer "$(bin stewart_viewer)" "${VIEWER_ARGS[@]}"
+  VIEWER_PIN=()
+  if [[ $LOOP_CPU != none ]]; then
+    OTHER_CPUS=$(seq 0 $(($(nproc) - 1)) | grep -vx "$LOOP_CPU" | paste -sd, -)
+    [[ -z $OTHER_CPUS ]] || VIEWER_PIN=(taskset -c "$OTHER_CPUS")
+  fi
+  start viewer "${VIEWER_PIN[@]}" "$(bin stewart_viewer)" "${VIEWER_ARGS[@]}"
   VIEWER_PID=${PIDS[-1]}
   echo "   viewer:     http://127.0.0.1:${VIEWER_PORT:-<viewer.port, 8080>}/ (viewer.log)"
 fi

@@ -4,10 +4,14 @@
 # runs, alternating without and with the viewer + browser, back to back.
 # Prints one line per run: latency p50/p99/max, missed ticks, the viewer's
 # CPU time.
-#   tools/viewer_cost.sh [PAIRS=3] [DURATION_S=20] [OUT=/tmp/viewer_cost]
+#   tools/viewer_cost.sh [PAIRS=3] [DURATION_S=20] [OUT=/tmp/viewer_cost] [BROWSER_CPUS]
+# BROWSER_CPUS (e.g. 0): run the browser on these CPUs only (taskset), off
+# the loop's CPU; default: wherever the scheduler puts it.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-PAIRS=${1:-3} DURATION=${2:-20} OUT=${3:-/tmp/viewer_cost}
+PAIRS=${1:-3} DURATION=${2:-20} OUT=${3:-/tmp/viewer_cost} BROWSER_CPUS=${4:-}
+BROWSER_PIN=()
+[[ -z $BROWSER_CPUS ]] || BROWSER_PIN=(taskset -c "$BROWSER_CPUS")
 BUILD=${STEWART_BUILD_DIR:-build}
 PORT=18980
 mkdir -p "$OUT"
@@ -19,7 +23,7 @@ run() { # index, with_viewer
     extra=(--viewer-port "$PORT")
     # The browser attaches once the viewer listens, and watches the whole run.
     (for _ in $(seq 100); do bash -c "exec 3<>/dev/tcp/127.0.0.1/$PORT" 2>/dev/null && break; sleep 0.1; done
-     node tests/viewer/browser/watch.js "http://127.0.0.1:$PORT/" "$((DURATION + 2))") >"$OUT/watch$1.log" 2>&1 &
+     "${BROWSER_PIN[@]}" node tests/viewer/browser/watch.js "http://127.0.0.1:$PORT/" "$((DURATION + 2))") >"$OUT/watch$1.log" 2>&1 &
     watcher=$!
   fi
   STEWART_BUILD_DIR=$BUILD tools/launch.sh --no-build --no-report --realtime --scenario paper \

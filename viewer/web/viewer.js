@@ -107,13 +107,22 @@ window.viewerState = { connected: false, frames: 0, renderedFrames: 0, mode: nul
     s.playback = frame.playback || null;
   }
 
+  // Renders only when there is something new to show (a frame, or the
+  // camera moved): an idle page costs its machine nothing.
+  let cameraMoved = true;
+  scene.controls.addEventListener('change', () => { cameraMoved = true; });
+  window.addEventListener('resize', () => { cameraMoved = true; });
   function animate() {
     requestAnimationFrame(animate);
-    if (latest && panels) {
+    const fresh = latest && panels;
+    if (fresh) {
       draw(latest);
       latest = null;
     }
-    scene.render();
+    if (fresh || cameraMoved) {
+      cameraMoved = false;
+      scene.render();
+    }
   }
 
   function connect() {
