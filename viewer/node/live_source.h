@@ -3,6 +3,7 @@
 // stores the newest value of each (SnapshotStore), so it keeps up with the
 // bus whatever the browsers do; frames are built from a copy elsewhere.
 #include <atomic>
+#include <chrono>
 #include <nlohmann/json.hpp>
 #include <thread>
 
@@ -17,6 +18,10 @@ namespace stewart::viewer {
 
 class LiveSource {
  public:
+  /// How often the receiving thread takes what the socket holds: well
+  /// above the 60 Hz a browser is sent (docs/performance.md, "The viewer's cost").
+  static constexpr std::chrono::milliseconds kDrainPeriod{5};
+
   LiveSource(const StackConfig& config, const FrameBuilder* builder);
   ~LiveSource();
   LiveSource(const LiveSource&) = delete;
