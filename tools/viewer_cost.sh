@@ -6,12 +6,13 @@
 # CPU time.
 #   tools/viewer_cost.sh [PAIRS=3] [DURATION_S=20] [OUT=/tmp/viewer_cost] [BROWSER_CPUS]
 # BROWSER_CPUS (e.g. 0): run the browser on these CPUs only (taskset), off
-# the loop's CPU; default: wherever the scheduler puts it.
+# the loop's CPU; default: wherever the scheduler puts it; "none": no
+# browser, the viewer alone.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 PAIRS=${1:-3} DURATION=${2:-20} OUT=${3:-/tmp/viewer_cost} BROWSER_CPUS=${4:-}
 BROWSER_PIN=()
-[[ -z $BROWSER_CPUS ]] || BROWSER_PIN=(taskset -c "$BROWSER_CPUS")
+[[ -z $BROWSER_CPUS || $BROWSER_CPUS == none ]] || BROWSER_PIN=(taskset -c "$BROWSER_CPUS")
 BUILD=${STEWART_BUILD_DIR:-build}
 PORT=18980
 mkdir -p "$OUT"
@@ -21,6 +22,8 @@ run() { # index, with_viewer
   local extra=() watcher=""
   if [[ $2 == 1 ]]; then
     extra=(--viewer-port "$PORT")
+  fi
+  if [[ $2 == 1 && $BROWSER_CPUS != none ]]; then
     # The browser attaches once the viewer listens, and watches the whole run.
     (for _ in $(seq 100); do bash -c "exec 3<>/dev/tcp/127.0.0.1/$PORT" 2>/dev/null && break; sleep 0.1; done
      "${BROWSER_PIN[@]}" node tests/viewer/browser/watch.js "http://127.0.0.1:$PORT/" "$((DURATION + 2))") >"$OUT/watch$1.log" 2>&1 &
