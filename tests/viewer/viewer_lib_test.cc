@@ -14,6 +14,7 @@
 #include "stewart/viewer/client_message.h"
 #include "stewart/viewer/frame_builder.h"
 #include "stewart/viewer/frame_rate_limiter.h"
+#include "stewart/viewer/latest_slot.h"
 #include "stewart/viewer/lcm_log_index.h"
 #include "stewart/viewer/playback_clock.h"
 
@@ -87,6 +88,19 @@ TEST(FrameRateLimiter, AtMostOneFramePerInterval) {
   EXPECT_GE(sent, 59);
   EXPECT_LE(sent, 60);
   EXPECT_THROW(FrameRateLimiter(0.0), InputError);
+}
+
+TEST(LatestSlot, ASlowReaderGetsTheNewestAndTheRestCountAsDropped) {
+  LatestSlot<int> slot;
+  EXPECT_FALSE(slot.Take().has_value());
+  EXPECT_FALSE(slot.Offer(1));
+  EXPECT_TRUE(slot.Offer(2));
+  EXPECT_TRUE(slot.Offer(3));
+  EXPECT_EQ(slot.Take(), 3) << "the newest frame, not the oldest";
+  EXPECT_TRUE(slot.empty());
+  EXPECT_EQ(slot.dropped(), 2);
+  EXPECT_FALSE(slot.Offer(4)) << "a taken frame is not dropped";
+  EXPECT_EQ(slot.dropped(), 2);
 }
 
 TEST(PlaybackClock, PlaysAtItsRateSeeksAndStopsAtTheEnd) {

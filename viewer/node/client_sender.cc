@@ -19,8 +19,7 @@ ClientSender::~ClientSender() {
 void ClientSender::OfferFrame(std::shared_ptr<const std::string> frame) {
   {
     const std::lock_guard<std::mutex> lock(mutex_);
-    if (pending_frame_ != nullptr) ++frames_dropped_;
-    pending_frame_ = std::move(frame);
+    pending_frame_.Offer(std::move(frame));
   }
   wake_.notify_all();
 }
@@ -40,7 +39,7 @@ int64_t ClientSender::frames_sent() const {
 
 int64_t ClientSender::frames_dropped() const {
   const std::lock_guard<std::mutex> lock(mutex_);
-  return frames_dropped_;
+  return pending_frame_.dropped();
 }
 
 void ClientSender::Run() {
@@ -51,13 +50,12 @@ void ClientSender::Run() {
     if (!pending_control_.empty()) {
       control = std::move(pending_control_.front());
       pending_control_.pop_front();
-    } else if (pending_frame_ != nullptr) {
+    } else if (!pending_frame_.empty()) {
       if (!limiter_.TryTake(FrameRateLimiter::Clock::now())) {
         wake_.wait_until(lock, limiter_.NextAllowed());
         continue;
       }
-      frame = std::move(pending_frame_);
-      pending_frame_.reset();
+      frame = *pending_frame_.Take();
     } else {
       wake_.wait(lock);
       continue;

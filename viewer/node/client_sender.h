@@ -14,6 +14,7 @@
 #include <thread>
 
 #include "stewart/viewer/frame_rate_limiter.h"
+#include "stewart/viewer/latest_slot.h"
 
 namespace stewart::viewer {
 
@@ -37,11 +38,10 @@ class ClientSender {
   FrameRateLimiter limiter_;
   mutable std::mutex mutex_;
   std::condition_variable wake_;
-  std::shared_ptr<const std::string> pending_frame_;
+  LatestSlot<std::shared_ptr<const std::string>> pending_frame_;
   std::deque<std::string> pending_control_;
   bool stop_ = false;
   int64_t frames_sent_ = 0;
-  int64_t frames_dropped_ = 0;
   std::thread thread_;  ///< last: starts once the members above exist
 };
 
