@@ -27,6 +27,9 @@ usage: tools/launch.sh [options]
   --no-log              do not record (no report either)
   --no-report           record, but do not write the report
   --spy                 also open lcm-spy on the run's URL
+  --viewer              also start stewart_viewer (read-only) on the run's URL: the page at
+                        http://127.0.0.1:8080/ (docs/operations.md, "The viewer")
+  --viewer-port N       its port (default: viewer.port of the config, 8080)
   --lcm-url URL         use this URL instead of a private one
   --out DIR             run folder (default: runs/<date>-<scenario>)
   --no-build            use the build as it is (skip tools/setup.sh; tests use this)
@@ -39,7 +42,7 @@ USAGE
 }
 
 PLANT=sim MODE="" SCENARIO=paper CONFIG="$ROOT/config/platform.yaml" VARIANT="" DURATION=""
-LOG="" DO_LOG=1 DO_REPORT=1 SPY=0 URL="" OUT="" EMULATOR=0 BUILD_FIRST=1 LCM_LOGGER=0 RT_PRIORITY='' LOOP_CPU=auto
+VIEWER=0 VIEWER_PORT="" LOG="" DO_LOG=1 DO_REPORT=1 SPY=0 URL="" OUT="" EMULATOR=0 BUILD_FIRST=1 LCM_LOGGER=0 RT_PRIORITY='' LOOP_CPU=auto
 TRUTH="" SEED=
 OVERLAYS=()
 ARGS="$*"
@@ -61,6 +64,8 @@ while (($#)); do
     --no-log) DO_LOG=0; DO_REPORT=0 ;;
     --no-report) DO_REPORT=0 ;;
     --spy) SPY=1 ;;
+    --viewer) VIEWER=1 ;;
+    --viewer-port) VIEWER=1; VIEWER_PORT=$2; shift ;;
     --lcm-url) URL=$2; shift ;;
     --out) OUT=$(realpath -m "$2"); shift ;;
     --no-build) BUILD_FIRST=0 ;;
@@ -224,6 +229,20 @@ if ((DO_LOG)); then
   echo "   recording:  $LOG"
 fi
 if ((SPY)); then start lcm-spy "$ROOT/tools/lcm-spy" --lcm-url="$URL"; fi
+if ((VIEWER)); then
+  # Normal scheduling, and off the loop's CPU when it has one: it only
+  # watches the bus.
+  VIEWER_ARGS=("${COMMON[@]}")
+  [[ -z $VIEWER_PORT ]] || VIEWER_ARGS+=(--port "$VIEWER_PORT")
+  VIEWER_PIN=()
+  if [[ $LOOP_CPU != none ]]; then
+    OTHER_CPUS=$(seq 0 $(($(nproc) - 1)) | grep -vx "$LOOP_CPU" | paste -sd, -)
+    [[ -z $OTHER_CPUS ]] || VIEWER_PIN=(taskset -c "$OTHER_CPUS")
+  fi
+  start viewer "${VIEWER_PIN[@]}" "$(bin stewart_viewer)" "${VIEWER_ARGS[@]}"
+  VIEWER_PID=${PIDS[-1]}
+  echo "   viewer:     http://127.0.0.1:${VIEWER_PORT:-<viewer.port, 8080>}/ (viewer.log)"
+fi
 
 SAFETY_ARGS=("${COMMON[@]}")
 [[ -z $VARIANT ]] || SAFETY_ARGS+=(--variant "$VARIANT")
@@ -266,7 +285,7 @@ while :; do
     if ! kill -0 "$pid" 2>/dev/null; then
       status=0; wait "$pid" || status=$?
       if [[ $name == "$PLANT_NAME" && $status -eq 0 ]]; then break 2; fi
-      [[ $name == monitor || $name == lcm-spy ]] && continue
+      [[ $name == monitor || $name == lcm-spy || $name == viewer ]] && continue
       fail "$name"
     fi
   done
@@ -279,12 +298,18 @@ while :; do
 done
 WALL=$(elapsed "$T0")
 sleep 0.5  # let the logger flush the last messages
+# The viewer's CPU time over the run (utime + stime of /proc/<pid>/stat).
+VIEWER_CPU=""
+if ((VIEWER)) && [[ -r /proc/$VIEWER_PID/stat ]]; then
+  VIEWER_CPU=$(awk -v hz="$(getconf CLK_TCK)" '{ sub(/^.*\) /, ""); printf "%.2f", ($12 + $13) / hz }' "/proc/$VIEWER_PID/stat")
+fi
 stop_all
 trap - INT TERM
 printf "== done: %s s simulated in %.1f s wall ==\n" "$DURATION" "$WALL"
 {
   echo "wall_time_s: $WALL"
   echo "load_average_at_start: $LOAD0"
+  [[ -z $VIEWER_CPU ]] || echo "viewer_cpu_s: $VIEWER_CPU"
   echo "cpu_steal_s: $(awk -v a="$STEAL0" -v b="$(steal_ticks)" -v hz="$(getconf CLK_TCK)" 'BEGIN { printf "%.2f", (b - a) / hz }')"
 } >> "$OUT/run.yaml"
 

@@ -18,7 +18,13 @@ PACKAGES=(
   libssl-dev
   iproute2 procps
   parallel
+  # stewart_viewer: the web server, three.js for the page, and the browser
+  # its test drives (docs/operations.md, "The viewer").
+  libcivetweb-dev libjs-three chromium
 )
+# node and npm drive that browser in the test (puppeteer-core); any node >= 18
+# will do, so an existing one (e.g. from NodeSource) is kept.
+if ! command -v node >/dev/null || ! command -v npm >/dev/null; then PACKAGES+=(nodejs npm); fi
 
 missing=()
 for pkg in "${PACKAGES[@]}"; do
@@ -31,6 +37,15 @@ if ((${#missing[@]})); then
   export DEBIAN_FRONTEND=noninteractive
   $SUDO apt-get update -qq
   $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
+
+# The browser test's client, exactly as pinned in its package-lock.json
+# (nothing is fetched at build or test time).
+BROWSER_TEST=tests/viewer/browser
+if [[ ! -f $BROWSER_TEST/node_modules/.package-lock.json ||
+      $BROWSER_TEST/package-lock.json -nt $BROWSER_TEST/node_modules/.package-lock.json ]]; then
+  echo "setup: npm ci in $BROWSER_TEST"
+  (cd "$BROWSER_TEST" && npm ci --no-audit --no-fund --loglevel=error >/dev/null)
 fi
 
 BUILD_DIR=${STEWART_BUILD_DIR:-build}

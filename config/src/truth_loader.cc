@@ -66,7 +66,7 @@ const std::set<std::string> kDisturbanceKeys = {
 // A whole stack config works as a truth: its other sections are not physics.
 const std::set<std::string> kIgnoredSections = {"controller", "safety", "estimator", "plant_sim",
                                                 "hw_bridge",  "rates",  "lcm",       "supervisor",
-                                                "guard"};
+                                                "guard",      "viewer"};
 
 void CheckKeys(const YAML::Node& node, const std::string& path, const std::set<std::string>& keys) {
   if (!node.IsMap()) throw ConfigError(path, "expected a mapping");
