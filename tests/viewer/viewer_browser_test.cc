@@ -29,26 +29,12 @@
 #include "stewart/node/lcm_receiver.h"
 #include "stewart/state_t.hpp"
 #include "stewart/test_support/child_process.h"
+#include "stewart/test_support/stack_launch.h"
 
 namespace stewart {
 namespace {
 
 const std::string kBrowserDir = STEWART_SOURCE_DIR "/tests/viewer/browser";
-
-/// The stack-starting tests' lock (tests/plausibility), so two stacks never
-/// share the two CPUs at once.
-class LauncherLock {
- public:
-  LauncherLock() : fd_(open(STEWART_BUILD_DIR "/stack_launch.lock", O_CREAT | O_RDWR, 0644)) {
-    if (fd_ >= 0) flock(fd_, LOCK_EX);
-  }
-  ~LauncherLock() {
-    if (fd_ >= 0) close(fd_);
-  }
-
- private:
-  int fd_;
-};
 
 std::string FindOnPath(const std::string& program) {
   const char* path = getenv("PATH");
@@ -169,7 +155,7 @@ bool WaitForPort(int port, double timeout_s) {
 TEST(ViewerBrowser, LivePageShowsTheStateItWasSentAndKeepsUpdating) {
   const std::string missing = MissingBrowserTools();
   ASSERT_TRUE(missing.empty()) << "the browser test needs:" << missing << " run tools/setup.sh";
-  LauncherLock lock;
+  test::LauncherLock lock;
   constexpr int kLcmPort = 7970;
   constexpr int kHttpPort = 18970;
   const StackConfig config = LoadStackConfig(DefaultConfigPath());
@@ -225,7 +211,7 @@ TEST(ViewerBrowser, LivePageShowsTheStateItWasSentAndKeepsUpdating) {
 TEST(ViewerBrowser, WithOperatorTheHoldButtonHoldsThePlatform) {
   const std::string missing = MissingBrowserTools();
   ASSERT_TRUE(missing.empty()) << "the browser test needs:" << missing << " run tools/setup.sh";
-  LauncherLock lock;
+  test::LauncherLock lock;
   constexpr int kLcmPort = 7972;
   constexpr int kHttpPort = 18972;
   const StackConfig config = LoadStackConfig(DefaultConfigPath());
@@ -265,7 +251,7 @@ TEST(ViewerBrowser, ScrubbingARecordedPaperRunTo15sShowsTheYPhase) {
   ASSERT_NE(mkdtemp(folder.data()), nullptr);
   const std::string run = folder + "/run";
   {
-    LauncherLock lock;
+    test::LauncherLock lock;
     setenv("STEWART_BUILD_DIR", STEWART_BUILD_DIR, 1);
     test::ChildProcess launch({"/bin/bash", STEWART_SOURCE_DIR "/tools/launch.sh", "--no-build",
                                "--no-report", "--scenario", "paper", "--duration", "20", "--out",

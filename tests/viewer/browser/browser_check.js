@@ -30,16 +30,18 @@ async function waitFor(page, predicate, arg, timeoutMs, what) {
 async function live(page, result) {
   await waitFor(page, () => window.viewerState.renderedFrames > 0 && window.viewerState.q, null, 20000,
                 'a rendered frame');
-  // Samples of what the page rendered, each after a newer frame was drawn
-  // (software WebGL on a loaded machine draws a few per second): each must
-  // be a state the stack sent, and they must move on.
+  // Samples of what the page rendered, each after a newer state was drawn
+  // (software WebGL on a loaded machine draws a few frames per second): each
+  // must be a state the stack sent, and they must move on.
   for (let k = 0; k < 5; k++) {
     const sample = await page.evaluate(() => ({
       utime_us: window.viewerState.utime_us, q: window.viewerState.q,
       renderedFrames: window.viewerState.renderedFrames, frames: window.viewerState.frames }));
     result.samples.push(sample);
-    await waitFor(page, (n) => window.viewerState.renderedFrames > n, sample.renderedFrames, 10000,
-                  'a newer rendered frame');
+    // A newer frame may redraw the same state (a heartbeat changed): wait
+    // for a newer state, which a running stack sends within well under 10 s.
+    await waitFor(page, (u) => window.viewerState.utime_us > u, sample.utime_us, 10000,
+                  'a newer state rendered');
   }
   result.operator = await page.evaluate(() => window.viewerState.operator);
   result.buttons_hidden = await page.$eval('#operator-buttons', (e) => e.hidden);
