@@ -81,25 +81,15 @@ TEST_P(ForgedNominalStack, MillionNewtonNominalsForTheNextSample) {
   receiver.Subscribe(ch.command_safe, &Bus::OnSafe, &bus);
   receiver.Subscribe(ch.health, &Bus::OnHealth, &bus);
   const auto pump_until = [&](auto done, double timeout_s) {
-    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
-    while (!done()) {
-      if (std::chrono::steady_clock::now() > end) return false;
-      receiver.HandleTimeout(1);
-    }
-    return true;
+    return test::PumpUntil(&receiver, done, timeout_s);
   };
 
-  // Armed by the supervisor at start-up, as tools/launch.sh does in simulation.
-  const std::string overlay = folder + "/auto_arm.yaml";
-  std::ofstream(overlay) << "supervisor:\n  auto_arm: true\n"
-                         << (bound ? ""
-                                   : "safety:\n  per_period_velocity_step_mps: 0.0\n"
-                                     "  per_period_angular_step_radps: 0.0\n");
-  const std::vector<std::string> common = {"--lcm-url", url,           "--overlay",
-                                           overlay,     "--log-level", "warn"};
-  const auto with = [&](std::vector<std::string> head) {
-    head.insert(head.end(), common.begin(), common.end());
-    return head;
+  const std::string overlay =
+      test::WriteAutoArmOverlay(folder, bound ? ""
+                                              : "safety:\n  per_period_velocity_step_mps: 0.0\n"
+                                                "  per_period_angular_step_radps: 0.0\n");
+  const auto with = [&](std::vector<std::string> argv) {
+    return test::WithStackFlags(std::move(argv), url, overlay);
   };
   test::ChildProcess logger(
       {LOGGER_PATH, "--lcm-url=" + url + "&recv_buf_size=4194304", "-f", log_path});

@@ -104,20 +104,12 @@ TEST(ForgedTimeStack, LockstepRunSurvivesForgedTimesAndTheWatchdogStillFires) {
   receiver.Subscribe(ch.command_safe, &Bus::OnSafe, &bus);
   receiver.Subscribe(ch.health, &Bus::OnHealth, &bus);
   const auto pump_until = [&](auto done, double timeout_s) {
-    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
-    while (!done()) {
-      if (std::chrono::steady_clock::now() > end) return false;
-      receiver.HandleTimeout(5);
-    }
-    return true;
+    return test::PumpUntil(&receiver, done, timeout_s);
   };
   const auto pump_for = [&](double seconds) { pump_until([] { return false; }, seconds); };
 
   // Armed by the supervisor at start-up, as tools/launch.sh does in simulation.
-  const std::string overlay = folder + "/auto_arm.yaml";
-  std::ofstream(overlay) << "supervisor:\n  auto_arm: true\n";
-  const std::vector<std::string> common = {"--lcm-url", url,           "--overlay",
-                                           overlay,     "--log-level", "warn"};
+  const std::string overlay = test::WriteAutoArmOverlay(folder);
   // As tools/launch.sh runs them: the loop on the last CPU, the logger and
   // this test on the others (docs/operations.md, "One CPU for the loop").
   const long cpus = sysconf(_SC_NPROCESSORS_ONLN);
@@ -127,8 +119,7 @@ TEST(ForgedTimeStack, LockstepRunSurvivesForgedTimesAndTheWatchdogStillFires) {
           : std::vector<std::string>{};
   const auto with = [&](std::vector<std::string> head) {
     head.insert(head.begin(), pin.begin(), pin.end());
-    head.insert(head.end(), common.begin(), common.end());
-    return head;
+    return test::WithStackFlags(std::move(head), url, overlay);
   };
   test::ChildProcess logger(
       {LOGGER_PATH, "--lcm-url=" + url + "&recv_buf_size=4194304", "-f", log_path});

@@ -23,6 +23,21 @@ LauncherLock::~LauncherLock() {
   if (fd_ >= 0) close(fd_);  // releases the lock
 }
 
+std::string WriteAutoArmOverlay(const std::string& folder, const std::string& extra_yaml) {
+  const std::string path = folder + "/stack_overlay.yaml";
+  std::ofstream(path) << "supervisor:\n  auto_arm: true\n" << extra_yaml;
+  return path;
+}
+
+std::vector<std::string> WithStackFlags(std::vector<std::string> argv, const std::string& url,
+                                        const std::string& overlay) {
+  for (const std::string& flag : {std::string("--lcm-url"), url, std::string("--overlay"), overlay,
+                                  std::string("--log-level"), std::string("warn")}) {
+    argv.push_back(flag);
+  }
+  return argv;
+}
+
 std::string ShellQuote(const std::string& s) {
   std::string quoted = "'";
   for (char ch : s) {

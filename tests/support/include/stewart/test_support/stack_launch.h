@@ -7,12 +7,14 @@
 #include <stdlib.h>
 
 #include <cerrno>
+#include <chrono>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <string>
 #include <system_error>
 #include <utility>
+#include <vector>
 
 namespace stewart::test {
 
@@ -60,6 +62,28 @@ class LauncherLock {
  private:
   int fd_;
 };
+
+/// Handles `receiver`'s messages (an LcmReceiver) until `done()` or
+/// `timeout_s` has passed: whether `done()`.
+template <typename Receiver, typename Done>
+bool PumpUntil(Receiver* receiver, Done done, double timeout_s) {
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+  while (!done()) {
+    if (std::chrono::steady_clock::now() > end) return false;
+    receiver->HandleTimeout(1);
+  }
+  return true;
+}
+
+/// Writes `folder`/stack_overlay.yaml: the supervisor armed at start-up, as
+/// tools/launch.sh does in simulation, plus `extra_yaml` (other sections);
+/// returns its path.
+std::string WriteAutoArmOverlay(const std::string& folder, const std::string& extra_yaml = "");
+
+/// `argv` plus the flags every stack process of a test takes: the private
+/// `url`, the `overlay`, warnings only.
+std::vector<std::string> WithStackFlags(std::vector<std::string> argv, const std::string& url,
+                                        const std::string& overlay);
 
 /// Why a launch failed, for the test's message: the exit code's meaning, the
 /// wall time and the launcher's whole output.
