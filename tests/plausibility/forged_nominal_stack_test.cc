@@ -91,12 +91,9 @@ TEST_P(ForgedNominalStack, MillionNewtonNominalsForTheNextSample) {
   const auto with = [&](std::vector<std::string> argv) {
     return test::WithStackFlags(std::move(argv), url, overlay);
   };
-  test::ChildProcess logger(
-      {LOGGER_PATH, "--lcm-url=" + url + "&recv_buf_size=4194304", "-f", log_path});
-  test::ChildProcess safety(with({SAFETY_PATH}));
-  test::ChildProcess controller(with({CONTROLLER_PATH, "--scenario", "paper"}));
-  test::ChildProcess estimator(with({ESTIMATOR_PATH}));
-  ASSERT_TRUE(logger.started() && safety.started() && controller.started() && estimator.started());
+  test::StackWithoutPlant stack({LOGGER_PATH, SAFETY_PATH, CONTROLLER_PATH, ESTIMATOR_PATH}, url,
+                                log_path, with);
+  ASSERT_TRUE(stack.started());
   ASSERT_TRUE(pump_until(
       [&] {
         return bus.health.count("safety") && bus.health.count("controller") &&
@@ -152,7 +149,7 @@ TEST_P(ForgedNominalStack, MillionNewtonNominalsForTheNextSample) {
     EXPECT_EQ(answered_forgeries, 0);
   }
 
-  logger.Stop(SIGTERM);
+  stack.logger.Stop(SIGTERM);
   const test::RecordedRun run = test::ReadRecordedRun(log_path, config);
   ASSERT_NE(run.Worst(), nullptr);
   std::printf("[forged nominal] %zu forgeries, %d answered bounded; %s\n", forged_samples.size(),

@@ -121,12 +121,9 @@ TEST(ForgedTimeStack, LockstepRunSurvivesForgedTimesAndTheWatchdogStillFires) {
     head.insert(head.begin(), pin.begin(), pin.end());
     return test::WithStackFlags(std::move(head), url, overlay);
   };
-  test::ChildProcess logger(
-      {LOGGER_PATH, "--lcm-url=" + url + "&recv_buf_size=4194304", "-f", log_path});
-  test::ChildProcess safety(with({SAFETY_PATH}));
-  test::ChildProcess controller(with({CONTROLLER_PATH, "--scenario", "paper"}));
-  test::ChildProcess estimator(with({ESTIMATOR_PATH}));
-  ASSERT_TRUE(logger.started() && safety.started() && controller.started() && estimator.started());
+  test::StackWithoutPlant stack({LOGGER_PATH, SAFETY_PATH, CONTROLLER_PATH, ESTIMATOR_PATH}, url,
+                                log_path, with);
+  ASSERT_TRUE(stack.started());
   ASSERT_TRUE(pump_until(
       [&] {
         return bus.health.count("safety") && bus.health.count("controller") &&
@@ -195,7 +192,7 @@ TEST(ForgedTimeStack, LockstepRunSurvivesForgedTimesAndTheWatchdogStillFires) {
   // test publishes further states (as the estimator would); from
   // safety.stale_age_s after the last nominal command on, each is answered
   // with the stale-input fallback.
-  controller.Stop(SIGKILL);
+  stack.controller.Stop(SIGKILL);
   const state_t last_state = bus.last_state;
   const int64_t last_nominal = bus.last_nominal.sample_utime;
   ASSERT_GT(last_nominal, 0);
@@ -220,7 +217,7 @@ TEST(ForgedTimeStack, LockstepRunSurvivesForgedTimesAndTheWatchdogStillFires) {
   EXPECT_GE(fallbacks, 30) << "the watchdog did not answer the states after the stale age";
 
   // The limits, on the recorded ground truth.
-  logger.Stop(SIGTERM);
+  stack.logger.Stop(SIGTERM);
   const test::RecordedRun run = test::ReadRecordedRun(log_path, config);
   ASSERT_NE(run.Worst(), nullptr);
   std::printf("[forged time] %s; %d watchdog fallbacks\n", test::Describe(run).c_str(), fallbacks);

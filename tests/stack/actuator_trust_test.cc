@@ -31,6 +31,7 @@
 #include "stewart/node/lcm_handle.h"
 #include "stewart/state_t.hpp"
 #include "stewart/test_support/child_process.h"
+#include "stewart/test_support/stack_launch.h"
 
 namespace stewart {
 namespace {
@@ -163,6 +164,7 @@ void ExpectZLimitsHeld(const Bus& bus, const StackConfig& config) {
 }
 
 TEST(ActuatorTrust, EstimatorStoppedHalfASecondNoStaleCommandIsApplied) {
+  test::LauncherLock lock;  // a real-time stack: no other stack or browser beside it
   const StackConfig config = LoadStackConfig(DefaultConfigPath());
   const std::string url = PrivateLcmUrl(7914);
   Bus bus(config, url);
@@ -199,6 +201,7 @@ struct AttackCase {
 class ActuatorTrustAttack : public ::testing::TestWithParam<AttackCase> {};
 
 TEST_P(ActuatorTrustAttack, ForgedCommandsAreDroppedAndTheLimitsHold) {
+  test::LauncherLock lock;  // a real-time stack: no other stack or browser beside it
   const AttackCase& c = GetParam();
   const StackConfig config = LoadStackConfig(DefaultConfigPath());
   const std::string url = PrivateLcmUrl(c.port);

@@ -18,6 +18,7 @@
 #include "stewart/force_command_t.hpp"
 #include "stewart/node/lcm_handle.h"
 #include "stewart/test_support/child_process.h"
+#include "stewart/test_support/stack_launch.h"
 
 namespace stewart {
 namespace {
@@ -40,6 +41,7 @@ bool IsFallback(const force_command_t& c) {
 }
 
 TEST(ControllerKill, SafetyFallsBackWithinTheStaleAgeAndThePlantKeepsGettingCommands) {
+  test::LauncherLock lock;  // a real-time stack: no other stack or browser beside it
   const StackConfig config = LoadStackConfig(DefaultConfigPath());
   const std::string url = PrivateLcmUrl(kPort);
   auto lcm = MakeLcm(url);

@@ -10,10 +10,8 @@
 // Each test prints one "[fault-to-hold]" line and bounds both from the
 // config (docs/operations.md, "Arming and e-stop", the table of faults).
 // LCM ports 7950-7957, one per test.
-#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <signal.h>
-#include <sys/file.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -34,6 +32,7 @@
 #include "stewart/state_t.hpp"
 #include "stewart/supervisor_state_t.hpp"
 #include "stewart/test_support/child_process.h"
+#include "stewart/test_support/stack_launch.h"
 
 namespace stewart {
 namespace {
@@ -45,23 +44,6 @@ int64_t WallUs() {
              std::chrono::system_clock::now().time_since_epoch())
       .count();
 }
-
-/// One stack start at a time per build folder (as tools/launch.sh's runs):
-/// parallel ctest runs do not share 2 cores four processes each.
-class LauncherLock {
- public:
-  LauncherLock() : fd_(open(STEWART_BUILD_DIR "/stack_launch.lock", O_CREAT | O_RDWR, 0644)) {
-    if (fd_ >= 0) flock(fd_, LOCK_EX);
-  }
-  ~LauncherLock() {
-    if (fd_ >= 0) close(fd_);  // releases the lock
-  }
-  LauncherLock(const LauncherLock&) = delete;
-  LauncherLock& operator=(const LauncherLock&) = delete;
-
- private:
-  int fd_;
-};
 
 template <typename Msg>
 struct Received {
@@ -331,7 +313,7 @@ double WatchdogHoldMs(const StackConfig& c) {
 
 /// The controller's nominal watchdog, then the fallback latch: SIGKILL.
 TEST(FaultToHold, ControllerKilled) {
-  LauncherLock lock;
+  test::LauncherLock lock;
   Stack stack("controller_killed", kPortBase + 0, "");
   stack.Start();
   ASSERT_TRUE(stack.Started());
@@ -377,7 +359,7 @@ const Received<health_t>* LastBeat(const Bus& bus, const std::string& name, int6
 /// actuators off (its sensor samples say so: STATUS_ACTUATORS_OFF), and
 /// HOLD latches when the estimator's heartbeat is lost (wall time).
 TEST(FaultToHold, EstimatorKilled) {
-  LauncherLock lock;
+  test::LauncherLock lock;
   Stack stack("estimator_killed", kPortBase + 1, "");
   stack.Start();
   ASSERT_TRUE(stack.Started());
@@ -422,7 +404,7 @@ TEST(FaultToHold, EstimatorKilled) {
 /// The estimator is killed and started again at once: its heartbeat starts
 /// over (a restart), its first states are not usable (initialising).
 TEST(FaultToHold, EstimatorRestarted) {
-  LauncherLock lock;
+  test::LauncherLock lock;
   Stack stack("estimator_restarted", kPortBase + 2, "");
   stack.Start();
   ASSERT_TRUE(stack.Started());
@@ -485,7 +467,7 @@ struct Relay {
 /// It publishes no nominal command meanwhile, so the safety process's
 /// watchdog runs as well: whichever latches first.
 TEST(FaultToHold, ControllerReportsFault) {
-  LauncherLock lock;
+  test::LauncherLock lock;
   const std::string controller_overlay = "lcm:\n  channels:\n    state_estimate: STATE_EST_RELAY\n";
   Stack stack("controller_fault", kPortBase + 3, "", controller_overlay);
   Relay relay;
@@ -528,7 +510,7 @@ TEST(FaultToHold, ControllerReportsFault) {
 /// commands stop at once (the watchdog), its heartbeat after
 /// heartbeat_timeout_s of wall time: both measured.
 TEST(FaultToHold, ControllerSilent) {
-  LauncherLock lock;
+  test::LauncherLock lock;
   Stack stack("controller_silent", kPortBase + 4, "");
   stack.Start();
   ASSERT_TRUE(stack.Started());
@@ -581,7 +563,7 @@ TEST(FaultToHold, ControllerSilent) {
 /// The operator's commands, from stewart_ctl: measured from the command's
 /// utime (when the console sent it).
 void OperatorCommand(const char* name, int port, const char* verb, int8_t command, int8_t state) {
-  LauncherLock lock;
+  test::LauncherLock lock;
   Stack stack(std::string("operator_") + verb, port, "");
   stack.Start();
   ASSERT_TRUE(stack.Started());
@@ -625,7 +607,7 @@ TEST(FaultToHold, OperatorEstop) {
 /// The dead-man (supervisor.operator_timeout_s 0.5 s): the console's
 /// heartbeats stop (SIGKILL).
 TEST(FaultToHold, OperatorDeadMan) {
-  LauncherLock lock;
+  test::LauncherLock lock;
   Stack stack("deadman", kPortBase + 7, "  operator_timeout_s: 0.5\n");
   // The console first: the dead-man counts from the safety process's start.
   test::ChildProcess console(stack.With({STEWART_CTL_PATH, "heartbeat", "--period", "0.1"}));

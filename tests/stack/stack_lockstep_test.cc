@@ -28,9 +28,9 @@ namespace {
 
 struct StackCase {
   const char* scenario;
-  int lcm_port;       // this file's private ports: 7820-7829
-  double duration_s;  // simulated seconds
-  double min_max_x;   // the platform must reach this x (m): the run challenged the limits
+  int lcm_port;            // this file's private ports: 7820-7829
+  double duration_s;       // simulated seconds
+  double min_max_x;        // the platform must reach this x (m): the run challenged the limits
   bool p16p_legs = false;  // with config/overlays/p16p.yaml: the prototype's DC-motor legs
 };
 

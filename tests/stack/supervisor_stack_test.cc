@@ -24,6 +24,7 @@
 #include "stewart/node/message_auth.h"
 #include "stewart/supervisor_state_t.hpp"
 #include "stewart/test_support/child_process.h"
+#include "stewart/test_support/stack_launch.h"
 
 namespace stewart {
 namespace {
@@ -63,6 +64,7 @@ bool DriveOff(const force_command_t& c) { return (c.flags & force_command_t::FLA
 bool Fallback(const force_command_t& c) { return (c.flags & force_command_t::FLAG_FALLBACK) != 0; }
 
 TEST(SupervisorStack, ArmHoldAfterARestartResumeAndEstopWithTheConsole) {
+  test::LauncherLock lock;  // a real-time stack: no other stack or browser beside it
   const StackConfig config = LoadStackConfig(DefaultConfigPath());
   const std::string url = PrivateLcmUrl(kPort);
   const std::string dir = ::testing::TempDir();
@@ -189,6 +191,7 @@ TEST(SupervisorStack, ArmHoldAfterARestartResumeAndEstopWithTheConsole) {
 // The dead-man: with supervisor.operator_timeout_s set, an armed platform
 // holds when the operator's console stops sending heartbeats.
 TEST(SupervisorStack, TheDeadManHoldsWhenTheOperatorsHeartbeatsStop) {
+  test::LauncherLock lock;  // a real-time stack: no other stack or browser beside it
   const StackConfig config = LoadStackConfig(DefaultConfigPath());
   const std::string url = PrivateLcmUrl(kPort + 1);
   const std::string overlay = ::testing::TempDir() + "supervisor_deadman_overlay.yaml";

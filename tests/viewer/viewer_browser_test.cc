@@ -171,10 +171,14 @@ TEST(ViewerBrowser, LivePageShowsTheStateItWasSentAndKeepsUpdating) {
   test::ChildProcess safety(with({SAFETY_PATH}));
   test::ChildProcess controller(with({CONTROLLER_PATH, "--scenario", "paper"}));
   test::ChildProcess estimator(with({ESTIMATOR_PATH}));
+  ASSERT_TRUE(viewer.started() && safety.started() && controller.started() && estimator.started());
+  // The plant last, once the stack listens: a first sample it sends before
+  // then is lost, and lockstep would wait for its answer to the end.
+  ASSERT_TRUE(recorder.WaitForHeartbeats({"safety", "controller", "estimator"}, 15.0))
+      << "the stack did not come up";
   // Lockstep, long enough to outlast the browser's start (~10x real time).
   test::ChildProcess plant(with({PLANT_SIM_PATH, "--mode", "lockstep", "--duration", "3000"}));
-  ASSERT_TRUE(viewer.started() && safety.started() && controller.started() && estimator.started() &&
-              plant.started());
+  ASSERT_TRUE(plant.started());
   ASSERT_TRUE(WaitForPort(kHttpPort, 10.0)) << "stewart_viewer did not listen on " << kHttpPort;
 
   const auto t0 = std::chrono::steady_clock::now();
@@ -250,8 +254,10 @@ TEST(ViewerBrowser, ScrubbingARecordedPaperRunTo15sShowsTheYPhase) {
   std::string folder = "/tmp/stewart_viewer_scrub_XXXXXX";
   ASSERT_NE(mkdtemp(folder.data()), nullptr);
   const std::string run = folder + "/run";
+  // The whole test under the lock, the browser too: software WebGL takes a
+  // core, and a lockstep stack sharing the other would lose messages.
+  test::LauncherLock lock;
   {
-    test::LauncherLock lock;
     setenv("STEWART_BUILD_DIR", STEWART_BUILD_DIR, 1);
     test::ChildProcess launch({"/bin/bash", STEWART_SOURCE_DIR "/tools/launch.sh", "--no-build",
                                "--no-report", "--scenario", "paper", "--duration", "20", "--out",

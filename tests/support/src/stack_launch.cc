@@ -29,6 +29,14 @@ std::string WriteAutoArmOverlay(const std::string& folder, const std::string& ex
   return path;
 }
 
+StackWithoutPlant::StackWithoutPlant(
+    const StackPrograms& programs, const std::string& url, const std::string& log_path,
+    const std::function<std::vector<std::string>(std::vector<std::string>)>& with)
+    : logger({programs.logger, "--lcm-url=" + url + "&recv_buf_size=4194304", "-f", log_path}),
+      safety(with({programs.safety})),
+      controller(with({programs.controller, "--scenario", "paper"})),
+      estimator(with({programs.estimator})) {}
+
 std::vector<std::string> WithStackFlags(std::vector<std::string> argv, const std::string& url,
                                         const std::string& overlay) {
   for (const std::string& flag : {std::string("--lcm-url"), url, std::string("--overlay"), overlay,

@@ -11,10 +11,13 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <system_error>
 #include <utility>
 #include <vector>
+
+#include "stewart/test_support/child_process.h"
 
 namespace stewart::test {
 
@@ -84,6 +87,25 @@ std::string WriteAutoArmOverlay(const std::string& folder, const std::string& ex
 /// `url`, the `overlay`, warnings only.
 std::vector<std::string> WithStackFlags(std::vector<std::string> argv, const std::string& url,
                                         const std::string& overlay);
+
+/// Paths of the programs a lockstep test starts (the test's TARGET_FILEs).
+struct StackPrograms {
+  std::string logger, safety, controller, estimator;
+};
+
+/// The logger and the stack's processes but the plant, as the lockstep tests
+/// start them: the logger recording `log_path` on `url`, the controller on
+/// the paper scenario; `with` adds each process's flags (WithStackFlags, a
+/// CPU pin). The plant comes last, once their heartbeats are in.
+struct StackWithoutPlant {
+  StackWithoutPlant(const StackPrograms& programs, const std::string& url,
+                    const std::string& log_path,
+                    const std::function<std::vector<std::string>(std::vector<std::string>)>& with);
+  bool started() const {
+    return logger.started() && safety.started() && controller.started() && estimator.started();
+  }
+  ChildProcess logger, safety, controller, estimator;
+};
 
 /// Why a launch failed, for the test's message: the exit code's meaning, the
 /// wall time and the launcher's whole output.
