@@ -244,6 +244,11 @@ TEST(ViewerBrowser, WithOperatorTheHoldButtonHoldsThePlatform) {
   EXPECT_EQ(result["supervisor"], "HOLD");
   EXPECT_NE(result["reply"].get<std::string>().find("accepted"), std::string::npos)
       << result["reply"];
+  // Seen on the operator channel too, its MAC verified (no "does not verify").
+  ASSERT_TRUE(result["last_operator_command"].is_string());
+  EXPECT_EQ(result["last_operator_command"].get<std::string>().find("does not verify"),
+            std::string::npos)
+      << result["last_operator_command"];
   EXPECT_EQ(viewer.Stop(SIGTERM), 0) << "stewart_viewer did not stop cleanly";
 }
 

@@ -47,6 +47,22 @@ TEST(FrameBuilder, LegsAreTheModelsInverseKinematicsAtTheEstimate) {
   EXPECT_TRUE(frame["truth"].is_null()) << "no ground truth was given";
 }
 
+TEST(FrameBuilder, TheLastOperatorCommandIsNamedAndMarkedWhenItsMacFails) {
+  const StackConfig config = LoadStackConfig(DefaultConfigPath());
+  const FrameBuilder builder(config.platform, config.safety, config.home_pose, {});
+  ViewerSnapshot s;
+  EXPECT_TRUE(builder.Frame(s)["operator_command"].is_null());
+  s.last_operator_command = {true, 42, 7, 2, "bench check", false};
+  nlohmann::json op = builder.Frame(s)["operator_command"];
+  EXPECT_EQ(op["command"], "hold");
+  EXPECT_EQ(op["operator_id"], "42");
+  EXPECT_EQ(op["seq"], 7);
+  EXPECT_EQ(op["note"], "bench check");
+  EXPECT_FALSE(op["authentic"].get<bool>());
+  s.last_operator_command.command = 99;  // not a command: named as such, no crash
+  EXPECT_EQ(builder.Frame(s)["operator_command"]["command"], "unknown");
+}
+
 TEST(FrameBuilder, ALegNearTheEndOfItsStrokeIsFlagged) {
   const StackConfig config = LoadStackConfig(DefaultConfigPath());
   const FrameBuilder builder(config.platform, config.safety, config.home_pose, {});

@@ -21,6 +21,7 @@ LiveSource::LiveSource(const StackConfig& config, const FrameBuilder* builder)
   receiver_.Subscribe(ch.safety_diagnostics, &LiveSource::OnDiagnostics, this);
   receiver_.Subscribe(ch.health, &LiveSource::OnHealth, this);
   receiver_.Subscribe(ch.supervisor, &LiveSource::OnSupervisor, this);
+  receiver_.Subscribe(ch.operator_command, &LiveSource::OnOperator, this);
   thread_ = std::thread([this] { Run(); });
 }
 
@@ -79,6 +80,14 @@ void LiveSource::OnSupervisor(const lcm::ReceiveBuffer*, const std::string&,
     return;
   }
   store_.Update([&](ViewerSnapshot& s) { s.supervisor = ToSample(*msg); });
+}
+
+void LiveSource::OnOperator(const lcm::ReceiveBuffer*, const std::string&,
+                            const operator_command_t* msg) {
+  // Shown whether or not it verifies, marked: a forged command on the bus is
+  // worth seeing (the supervisor refuses it).
+  OperatorSample sample = ToSample(*msg, auth_.Verify(*msg));
+  store_.Update([&](ViewerSnapshot& s) { s.last_operator_command = std::move(sample); });
 }
 
 nlohmann::json LiveSource::NextFrame() {

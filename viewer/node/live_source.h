@@ -42,6 +42,7 @@ class LiveSource {
                      const safety_diagnostics_t* msg);
   void OnHealth(const lcm::ReceiveBuffer*, const std::string&, const health_t* msg);
   void OnSupervisor(const lcm::ReceiveBuffer*, const std::string&, const supervisor_state_t* msg);
+  void OnOperator(const lcm::ReceiveBuffer*, const std::string&, const operator_command_t* msg);
   void Run();
 
   const FrameBuilder* builder_;

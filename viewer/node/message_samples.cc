@@ -99,4 +99,15 @@ SupervisorSample ToSample(const supervisor_state_t& msg) {
   return s;
 }
 
+OperatorSample ToSample(const operator_command_t& msg, bool authentic) {
+  OperatorSample s;
+  s.valid = true;
+  s.operator_id = msg.operator_id;
+  s.seq = msg.seq;
+  s.command = msg.command;
+  s.note = msg.note;
+  s.authentic = authentic;
+  return s;
+}
+
 }  // namespace stewart::viewer

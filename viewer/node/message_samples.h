@@ -3,6 +3,7 @@
 // samples (stewart/viewer/snapshot.h), shared by the live bus and the log.
 #include "stewart/force_command_t.hpp"
 #include "stewart/health_t.hpp"
+#include "stewart/operator_command_t.hpp"
 #include "stewart/safety_diagnostics_t.hpp"
 #include "stewart/setpoint_t.hpp"
 #include "stewart/state_t.hpp"
@@ -17,5 +18,6 @@ ForceSample ToSample(const force_command_t& msg);
 DiagnosticsSample ToSample(const safety_diagnostics_t& msg);
 HealthSample ToSample(const health_t& msg);
 SupervisorSample ToSample(const supervisor_state_t& msg);
+OperatorSample ToSample(const operator_command_t& msg, bool authentic);
 
 }  // namespace stewart::viewer

@@ -4,6 +4,7 @@
 #include <utility>
 
 #include "stewart/model/kinematics.h"
+#include "stewart/safety/supervisor.h"
 
 namespace stewart::viewer {
 namespace {
@@ -152,6 +153,20 @@ json FrameBuilder::Frame(const ViewerSnapshot& s) const {
                            {"last_operator_reply", v.last_operator_reply}};
   } else {
     frame["supervisor"] = nullptr;
+  }
+  if (s.last_operator_command.valid) {
+    const OperatorSample& o = s.last_operator_command;
+    const bool known = o.command >= static_cast<int>(safety::OperatorCommand::kArm) &&
+                       o.command <= static_cast<int>(safety::OperatorCommand::kHeartbeat);
+    frame["operator_command"] = {
+        {"operator_id", std::to_string(o.operator_id)},
+        {"seq", o.seq},
+        {"command",
+         known ? safety::ToString(static_cast<safety::OperatorCommand>(o.command)) : "unknown"},
+        {"note", o.note},
+        {"authentic", o.authentic}};
+  } else {
+    frame["operator_command"] = nullptr;
   }
   json health = json::array();
   for (const auto& [name, h] : s.health) {

@@ -29,22 +29,27 @@ class Panels {
   }
 
   update(frame) {
-    this.supervisor(frame.supervisor);
+    this.supervisor(frame.supervisor, frame.operator_command);
     this.forces(frame.nominal, frame.safe);
     this.filter(frame.diagnostics);
     this.estimator(frame.estimate);
     this.health(frame.health);
   }
 
-  supervisor(s) {
+  supervisor(s, op) {
     const badge = document.getElementById('supervisor');
     if (!s) { badge.textContent = 'supervisor ?'; return; }
     badge.textContent = s.state_name;
     badge.className = 'badge ' + (SUPERVISOR_CLASS[s.state_name] || '');
+    // The newest operator command on the bus (live only), marked when its
+    // MAC does not verify: the supervisor refuses those.
+    const last = op ? `<br>last operator command: ${escapeHtml(op.command)} from ` +
+      `${escapeHtml(op.operator_id)} #${op.seq}${op.authentic ? '' : ' <b>(MAC does not verify)</b>'}` +
+      `${op.note ? ' (' + escapeHtml(op.note) + ')' : ''}` : '';
     document.getElementById('supervisor-detail').innerHTML =
       `<b>${s.state_name}</b> ${s.state_name === 'ARMING' ? fmt(100 * s.arming_progress, 0) + ' %' : ''}` +
       ` motion ${fmt(s.motion_time_s, 2)} s${s.fault_latched ? ' <b>fault latched: reset</b>' : ''}` +
-      `<br>${escapeHtml(s.reason)}`;
+      `<br>${escapeHtml(s.reason)}${last}`;
     if (this.hello.operator && s.last_operator_id === this.hello.operator_id) {
       document.getElementById('operator-reply').textContent =
         `#${s.last_operator_seq}: ${s.last_operator_reply === '' ? 'accepted' : 'refused: ' + s.last_operator_reply}`;

@@ -80,6 +80,10 @@ async function operator(page, result) {
                 'the supervisor\'s reply');
   result.reply = await page.$eval('#operator-reply', (e) => e.textContent);
   result.supervisor = await page.evaluate(() => window.viewerState.supervisor);
+  // The viewer also shows the command as it saw it on the operator channel.
+  await waitFor(page, () => document.getElementById('supervisor-detail').textContent
+    .includes('last operator command: hold'), null, 10000, 'the hold on the operator channel');
+  result.last_operator_command = await page.$eval('#supervisor-detail', (e) => e.textContent);
 }
 
 async function main() {

@@ -82,6 +82,18 @@ struct SupervisorSample {
   std::string last_operator_reply;
 };
 
+/// The newest operator command on the bus (operator_command_t), live only:
+/// its utime is the console's wall clock, which a log index by stack time
+/// cannot place (the supervisor's state carries the last one it judged).
+struct OperatorSample {
+  bool valid = false;
+  int64_t operator_id = 0;
+  int64_t seq = 0;
+  int command = 0;  ///< operator_command_t.COMMAND_*
+  std::string note;
+  bool authentic = false;  ///< its MAC verified under the run's key (true without one)
+};
+
 struct ViewerSnapshot {
   StateSample estimate;
   StateSample truth;
@@ -90,6 +102,7 @@ struct ViewerSnapshot {
   ForceSample safe;
   DiagnosticsSample diagnostics;
   SupervisorSample supervisor;
+  OperatorSample last_operator_command;
   std::map<std::string, HealthSample> health;  ///< by process name
 };
 
