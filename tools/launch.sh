@@ -214,6 +214,11 @@ fail() { # name of the process that died
   exit 1
 }
 trap 'echo; echo "launch: interrupted, stopping every process"; stop_all; exit 130' INT TERM
+# A reader that goes away (`tools/launch.sh | head`) or a closed terminal:
+# stop every process before exiting, and on any other exit path too.
+trap 'stop_all; exit 141' PIPE
+trap 'stop_all; exit 129' HUP
+trap 'stop_all' EXIT
 
 if ((DO_LOG)); then
   if ((LCM_LOGGER)); then
@@ -304,7 +309,7 @@ if ((VIEWER)) && [[ -r /proc/$VIEWER_PID/stat ]]; then
   VIEWER_CPU=$(awk -v hz="$(getconf CLK_TCK)" '{ sub(/^.*\) /, ""); printf "%.2f", ($12 + $13) / hz }' "/proc/$VIEWER_PID/stat")
 fi
 stop_all
-trap - INT TERM
+trap - INT TERM PIPE HUP
 printf "== done: %s s simulated in %.1f s wall ==\n" "$DURATION" "$WALL"
 {
   echo "wall_time_s: $WALL"
