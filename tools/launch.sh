@@ -23,7 +23,8 @@ usage: tools/launch.sh [options]
   --seed N              sensor noise and disturbance seed of the simulated plant
   --variant V           safety filter: closed_form | paper | qp | uncomposed (default: from config)
   --duration S          simulated seconds (default: the scenario's duration)
-  --log FILE            record every channel with lcm-logger (default: <run>/log.lcm)
+  --log FILE            record every channel to FILE (default: <run>/log.lcm), with
+                        stewart_logger (or lcm-logger with --lcm-logger)
   --no-log              do not record (no report either)
   --no-report           record, but do not write the report
   --spy                 also open lcm-spy on the run's URL
@@ -319,5 +320,5 @@ printf "== done: %s s simulated in %.1f s wall ==\n" "$DURATION" "$WALL"
 } >> "$OUT/run.yaml"
 
 if ((DO_REPORT)); then
-  "$ROOT/tools/report.sh" "$OUT"
+  "$ROOT/tools/report.sh" "$OUT" "$LOG"
 fi

@@ -1,6 +1,8 @@
 // tools/launch.sh stops every process it started on every exit path. Piped
 // into `head`, it used to die of SIGPIPE at its next line of output and
-// leave the logger, safety, controller, estimator and monitor running.
+// leave the logger, safety, controller, estimator and monitor running. And
+// tools/report.sh says what is wrong with a folder it cannot report on (it
+// exited 105, silently), and reports a run recorded with --log elsewhere.
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -43,6 +45,39 @@ TEST(LaunchExit, PipedIntoHeadLeavesNoProcessBehind) {
   }
   EXPECT_TRUE(gone) << "processes started by tools/launch.sh are still running";
   if (!gone) Shell("pkill -KILL -f '239[.]255[.]76[.]67:789[8]'");
+}
+
+std::string ReportSh(const std::string& args, int* code) {
+  const std::string err = ::testing::TempDir() + "report_sh_err.txt";
+  *code = Shell("cd " + ShellQuote(STEWART_SOURCE_DIR) +
+                " && STEWART_BUILD_DIR=" + ShellQuote(STEWART_BUILD_DIR) + " tools/report.sh " +
+                args + " >/dev/null 2>" + ShellQuote(err));
+  return ReadFile(err);
+}
+
+TEST(ReportSh, AFolderItCannotReportOnGetsOneClearError) {
+  int code = 0;
+  std::string err = ReportSh("/nonexistent/run", &code);
+  EXPECT_EQ(code, 2);
+  EXPECT_NE(err.find("is not a run folder"), std::string::npos) << err;
+  const std::string empty = ::testing::TempDir() + "report_empty_run";
+  ASSERT_EQ(
+      Shell("mkdir -p " + ShellQuote(empty) + " && : > " + ShellQuote(empty + "/config.yaml")), 0);
+  err = ReportSh(ShellQuote(empty), &code);
+  EXPECT_EQ(code, 2);
+  EXPECT_NE(err.find("no log"), std::string::npos) << err;
+}
+
+TEST(ReportSh, ARunRecordedElsewhereWithLogIsReported) {
+  const std::string run = ::testing::TempDir() + "launch_log_elsewhere_run";
+  const std::string log = ::testing::TempDir() + "launch_log_elsewhere.lcm";
+  Shell("rm -rf " + ShellQuote(run) + " " + ShellQuote(log));
+  const LaunchResult launch = RunLauncher("--no-build --duration 2 --log " + ShellQuote(log), kPort,
+                                          run, ::testing::TempDir() + "launch_log.txt");
+  ASSERT_EQ(launch.exit_code, 0) << LaunchFailure(launch);
+  EXPECT_FALSE(ReadFile(log).empty()) << "nothing recorded to " << log;
+  EXPECT_NE(ReadFile(run + "/report.md").find("## Limits"), std::string::npos)
+      << "no report for the run recorded with --log";
 }
 
 }  // namespace
