@@ -9,6 +9,7 @@
 #include "stewart/guard/guard_limits.h"
 #include "stewart/node/eigen_msg.h"
 #include "stewart/node/node_loop.h"
+#include "stewart/node/operator_reset.h"
 #include "stewart/node/signal_messages.h"
 #include "stewart/node/stop_signal.h"
 #include "stewart/sensor_t.hpp"
@@ -178,15 +179,8 @@ void BridgeNode::OnSupervisor(const lcm::ReceiveBuffer*, const std::string&,
 
 void BridgeNode::OnOperator(const lcm::ReceiveBuffer*, const std::string&,
                             const operator_command_t* msg) {
-  // Only RESET concerns the bridge; the supervisor judges the rest.
-  if (msg->command != operator_command_t::COMMAND_RESET) return;
-  health_.CountIn();
-  const OperatorVerdict v = operator_check_.Check(msg->operator_id, msg->seq, msg->utime,
-                                                  auth_.Verify(*msg), WallMicros());
-  if (v != OperatorVerdict::kAccepted) {
-    health_.Reject(ToString(v), "operator_command_t RESET from " +
-                                    std::to_string(msg->operator_id) + ", seq " +
-                                    std::to_string(msg->seq));
+  // Only RESET concerns the bridge (its guard); the supervisor judges the rest.
+  if (!AcceptActuatorReset(*msg, auth_.Verify(*msg), WallMicros(), &operator_check_, &health_)) {
     return;
   }
   const bool was_tripped = bridge_.actuator_guard().tripped();

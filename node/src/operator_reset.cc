@@ -34,6 +34,18 @@ bool OperatorResetFilter::OnCommand(const operator_command_t& msg, int64_t recei
   return false;
 }
 
+bool AcceptActuatorReset(const operator_command_t& msg, bool authentic, int64_t wall_now_us,
+                         OperatorCommandCheck* check, HealthCounters* counters) {
+  if (msg.command != operator_command_t::COMMAND_RESET) return false;
+  counters->CountIn();
+  const OperatorVerdict v =
+      check->Check(msg.operator_id, msg.seq, msg.utime, authentic, wall_now_us);
+  if (v == OperatorVerdict::kAccepted) return true;
+  counters->Reject(ToString(v), "operator_command_t RESET from " + std::to_string(msg.operator_id) +
+                                    ", seq " + std::to_string(msg.seq));
+  return false;
+}
+
 OperatorResets::OperatorResets(const LcmConfig& lcm)
     : url_(lcm.url),
       channel_(lcm.channels.operator_command),

@@ -9,6 +9,7 @@
 #include "stewart/guard/guard_limits.h"
 #include "stewart/node/eigen_msg.h"
 #include "stewart/node/node_loop.h"
+#include "stewart/node/operator_reset.h"
 #include "stewart/node/signal_messages.h"
 #include "stewart/node/stop_signal.h"
 #include "stewart/plant_sim/lockstep_pacing.h"
@@ -253,15 +254,8 @@ void PlantSimNode::HandleSupervisor(const lcm::ReceiveBuffer*, const std::string
 
 void PlantSimNode::HandleOperator(const lcm::ReceiveBuffer*, const std::string&,
                                   const operator_command_t* msg) {
-  // Only RESET concerns the plant; the supervisor judges the rest.
-  if (msg->command != operator_command_t::COMMAND_RESET) return;
-  health_.CountIn();
-  const OperatorVerdict v = operator_check_.Check(msg->operator_id, msg->seq, msg->utime,
-                                                  auth_.Verify(*msg), WallMicros());
-  if (v != OperatorVerdict::kAccepted) {
-    health_.Reject(ToString(v), "operator_command_t RESET from " +
-                                    std::to_string(msg->operator_id) + ", seq " +
-                                    std::to_string(msg->seq));
+  // Only RESET concerns the plant (its guard); the supervisor judges the rest.
+  if (!AcceptActuatorReset(*msg, auth_.Verify(*msg), WallMicros(), &operator_check_, &health_)) {
     return;
   }
   const bool was_tripped = guard_.tripped();

@@ -21,6 +21,7 @@
 #include <memory>
 #include <string>
 
+#include "stewart/common/health_counters.h"
 #include "stewart/guard/operator_command_check.h"
 #include "stewart/node/lcm_config.h"
 #include "stewart/node/lcm_receiver.h"
@@ -51,6 +52,14 @@ class OperatorResetFilter {
   OperatorCommandCheck check_;  // the actuators' rule: MAC, time window, seq per console
   OperatorResetCounts counts_;
 };
+
+/// For an actuator's own RESET (its guard's latch, plant_sim and hw_bridge):
+/// whether `msg` is a RESET to act on under `check` (MAC `authentic`,
+/// `wall_now_us` its receiver's wall clock). A RESET is counted in `counters`
+/// as an input, and a refused one as a rejection named by its verdict; other
+/// commands (the supervisor's) are not this receiver's business.
+bool AcceptActuatorReset(const operator_command_t& msg, bool authentic, int64_t wall_now_us,
+                         OperatorCommandCheck* check, HealthCounters* counters);
 
 /// The process's RESETs: one OperatorResetFilter on the operator channel,
 /// fed by the node's own receiver when it attaches one (no extra socket:
