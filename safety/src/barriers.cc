@@ -13,17 +13,32 @@ void EvaluateBarriers(const ConstraintSet& c, const Vector6d& q, const Vector6d&
   EvaluateBarriers(c, q, qd, terms, f_des, 0.0, GeneralizedDisturbance{}, out, &unused);
 }
 
+void PrepareBarrierIntermediates(const DynamicsTerms& terms, const Vector6d& qd,
+                                 BarrierIntermediates* x) {
+  x->leg_rate.noalias() = terms.H.transpose() * qd;  // ld = J_l qd, J_l = H^T
+  // One factor of M per step, shared by the velocity group, the acceleration
+  // metric and the per-period bound (SafetyFilter).
+  x->inertia_valid = x->inertia.Compute(terms.M);
+}
+
 void EvaluateBarriers(const ConstraintSet& c, const Vector6d& q, const Vector6d& qd,
                       const DynamicsTerms& terms, const Vector6d& f_des, double leg_friction_nspm,
                       const GeneralizedDisturbance& disturbance, BarrierEvaluation* out,
                       BarrierIntermediates* x) {
+  PrepareBarrierIntermediates(terms, qd, x);
+  EvaluatePreparedBarriers(c, q, qd, terms, f_des, leg_friction_nspm, disturbance, out, x);
+}
+
+void EvaluatePreparedBarriers(const ConstraintSet& c, const Vector6d& q, const Vector6d& qd,
+                              const DynamicsTerms& terms, const Vector6d& f_des,
+                              double leg_friction_nspm, const GeneralizedDisturbance& disturbance,
+                              BarrierEvaluation* out, BarrierIntermediates* x) {
   // The per-barrier arrays hold kMax* entries (a hand-built ConstraintSet
   // skips BuildConstraintSet's capacity check).
   STEWART_CHECK(static_cast<unsigned>(c.num_position) <= kMaxPositionBarriers &&
                     static_cast<unsigned>(c.num_velocity) <= kMaxVelocityBarriers,
                 "EvaluateBarriers: more barriers than their arrays hold");
   BarrierEvaluation& e = *out;
-  x->leg_rate.noalias() = terms.H.transpose() * qd;  // ld = J_l qd, J_l = H^T
   // The conditions hold for what the legs really push: F + friction.
   const Vector6d f_net = f_des + LegViscousFriction(leg_friction_nspm, x->leg_rate);
   Vector6d generalised_force;  // H F_net + d^
@@ -36,9 +51,6 @@ void EvaluateBarriers(const ConstraintSet& c, const Vector6d& q, const Vector6d&
   e.outside_safe_set = false;
   x->m_qd.noalias() = terms.M * qd;
   x->qd_m_qd = qd.dot(x->m_qd);
-  // One factor of M per step, shared by the velocity group and the
-  // acceleration metric (SafetyFilter).
-  x->inertia_valid = x->inertia.Compute(terms.M);
 
   if (c.num_position > 0) {
     const double kinetic = 0.5 * x->qd_m_qd;

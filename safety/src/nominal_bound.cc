@@ -17,12 +17,14 @@ Vector6d NominalAccelerationBound(double sample_period_s, double velocity_step_m
   return max_accel;
 }
 
-double BoundNominal(const DynamicsTerms& terms, const Vector6d& leg_speed_mps,
-                    double leg_friction_nspm, const Vector6d& disturbance_n,
-                    const Vector6d& max_accel, const Vector6d& f_des, Vector6d* f_bounded) {
+double BoundNominal(const DynamicsTerms& terms, const Cholesky6& inertia,
+                    const Vector6d& leg_speed_mps, double leg_friction_nspm,
+                    const Vector6d& disturbance_n, const Vector6d& max_accel, const Vector6d& f_des,
+                    Vector6d* f_bounded) {
   *f_bounded = f_des;
   const Vector6d friction_n = LegViscousFriction(leg_friction_nspm, leg_speed_mps);
-  const Vector6d qdd_des = ForwardDynamics(terms, f_des + friction_n, disturbance_n);
+  const Vector6d qdd_des =
+      inertia.Solve<1>(terms.H * (f_des + friction_n) + disturbance_n - terms.C_qd - terms.G);
   if (!qdd_des.allFinite()) return 0.0;
   double scale = 1.0;
   for (int j = 0; j < 6; ++j) {

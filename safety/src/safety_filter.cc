@@ -161,9 +161,13 @@ Vector6d SafetyFilter::StepWithTerms(const DynamicsTerms& terms, const Vector6d&
   d->nominal_scale = 1.0;
   Vector6d& f_nominal = d->f_nominal;
   f_nominal = f_des;
+  if (ok) PrepareBarrierIntermediates(terms, qd, &ws.barrier);
   if (ok && bound_nominal_) {
-    const double scale = BoundNominal(terms, terms.H.transpose() * qd, leg_friction_nspm_,
-                                      held_disturbance, nominal_max_accel_, f_des, &f_nominal);
+    const double scale =
+        ws.barrier.inertia_valid
+            ? BoundNominal(terms, ws.barrier.inertia, ws.barrier.leg_rate, leg_friction_nspm_,
+                           held_disturbance, nominal_max_accel_, f_des, &f_nominal)
+            : 0.0;
     ok = scale > 0.0;
     if (scale < 1.0) {
       d->nominal_scale = scale;
@@ -172,9 +176,9 @@ Vector6d SafetyFilter::StepWithTerms(const DynamicsTerms& terms, const Vector6d&
   }
   const StepInput in{terms, qd, f_nominal, d->barriers, held_disturbance};
   if (ok) {
-    EvaluateBarriers(constraints_, q, qd, terms, f_nominal, leg_friction_nspm_,
-                     use_disturbance_ ? disturbance : GeneralizedDisturbance{}, &d->barriers,
-                     &ws.barrier);
+    EvaluatePreparedBarriers(constraints_, q, qd, terms, f_nominal, leg_friction_nspm_,
+                             use_disturbance_ ? disturbance : GeneralizedDisturbance{},
+                             &d->barriers, &ws.barrier);
     ok = BarriersFinite(d->barriers) &&
          (metric_ == CorrectionMetric::kForce || ws.barrier.inertia_valid);
   }

@@ -86,4 +86,17 @@ void EvaluateBarriers(const ConstraintSet& constraints, const Vector6d& q, const
                       const GeneralizedDisturbance& disturbance, BarrierEvaluation* out,
                       BarrierIntermediates* intermediates);
 
+/// The part of the intermediates that does not depend on F_des (the factor
+/// of M, H^T qd), for a caller that needs it first (the filter's per-period
+/// bound on F_des, nominal_bound.h).
+void PrepareBarrierIntermediates(const DynamicsTerms& terms, const Vector6d& qd,
+                                 BarrierIntermediates* intermediates);
+
+/// EvaluateBarriers with `intermediates` already prepared by
+/// PrepareBarrierIntermediates at the same (terms, qd): M is factored once.
+void EvaluatePreparedBarriers(const ConstraintSet& constraints, const Vector6d& q,
+                              const Vector6d& qd, const DynamicsTerms& terms, const Vector6d& f_des,
+                              double leg_friction_nspm, const GeneralizedDisturbance& disturbance,
+                              BarrierEvaluation* out, BarrierIntermediates* intermediates);
+
 }  // namespace stewart::safety

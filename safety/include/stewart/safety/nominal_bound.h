@@ -19,6 +19,7 @@
 // safety.per_period_velocity_step_mps (x, y, z; m/s) and
 // safety.per_period_angular_step_radps (Euler angles; rad/s).
 #include "stewart/model/dynamics.h"
+#include "stewart/model/linear_algebra6.h"
 
 namespace stewart::safety {
 
@@ -29,13 +30,16 @@ Vector6d NominalAccelerationBound(double sample_period_s, double velocity_step_m
 
 /// Scales f_des (N, per leg) towards the zero-acceleration force at the
 /// model terms `terms` (at q, qd) so that the model acceleration obeys
-/// |qdd_j| <= max_accel_j; leg_speed_mps = H^T qd and leg_friction_nspm the
-/// filter's leg friction; disturbance_n the estimated model error d (N, N m).
-/// Returns the scale s in (0, 1] (1: f_bounded == f_des exactly). On a
-/// non-finite model acceleration or zero-acceleration force, returns 0 and
-/// leaves *f_bounded = f_des: the caller treats the step as invalid.
-double BoundNominal(const DynamicsTerms& terms, const Vector6d& leg_speed_mps,
-                    double leg_friction_nspm, const Vector6d& disturbance_n,
-                    const Vector6d& max_accel, const Vector6d& f_des, Vector6d* f_bounded);
+/// |qdd_j| <= max_accel_j; `inertia` the factor of terms.M (computed by the
+/// caller, who needs it anyway), leg_speed_mps = H^T qd and
+/// leg_friction_nspm the filter's leg friction; disturbance_n the estimated
+/// model error d (N, N m). Returns the scale s in (0, 1] (1: f_bounded ==
+/// f_des exactly). On a non-finite model acceleration or zero-acceleration
+/// force, returns 0 and leaves *f_bounded = f_des: the caller treats the step
+/// as invalid.
+double BoundNominal(const DynamicsTerms& terms, const Cholesky6& inertia,
+                    const Vector6d& leg_speed_mps, double leg_friction_nspm,
+                    const Vector6d& disturbance_n, const Vector6d& max_accel, const Vector6d& f_des,
+                    Vector6d* f_bounded);
 
 }  // namespace stewart::safety
