@@ -5,6 +5,10 @@
 // and its payload's offset in the file. Seeking to any instant is then a
 // binary search per channel and one read per message, whatever the log's
 // length. Raw bytes only: decoding is the caller's (no LCM dependency).
+// Not lcm::LogFile (which the replay and the log export use for sequential
+// reading): it exposes no event offsets, and its stream position after an
+// event is off at the end of a log cut short (LCM 1.3 reads ahead for the
+// next sync word), which would misplace the last payload.
 #include <cstdint>
 #include <string>
 #include <vector>
