@@ -3,7 +3,8 @@
 // lockstep run of the real processes on a private URL. Each forgery is timed
 // for the next sample, so the safety process filters it before the
 // controller's own: +-1e6 N per leg, once a second and then in a stream of
-// 100 consecutive samples. Every limit must hold on the recorded ground
+// 100 consecutive samples, against a plant heavier than the model with a
+// payload. Every limit must hold on the recorded ground
 // truth, every answer to a forgery must carry FLAG_NOMINAL_BOUNDED, and the
 // safety heartbeat must count them (docs/safety.md "One sample period").
 // With the bound switched off (the before), the first forgery makes the
@@ -91,6 +92,12 @@ TEST_P(ForgedNominalStack, MillionNewtonNominalsForTheNextSample) {
   const auto with = [&](std::vector<std::string> argv) {
     return test::WithStackFlags(std::move(argv), url, overlay);
   };
+  // The plant is not the model the stack uses: 20 % heavier, a 0.2 kg payload
+  // off-centre, more leg friction (within docs/safety.md's stated bounds).
+  const std::string truth = folder + "/truth.yaml";
+  std::ofstream(truth) << "platform:\n  mass_kg: 0.75\n"
+                          "  payload: {mass_kg: 0.2, position_m: [0.05, -0.03, 0.03]}\n"
+                          "actuators: {viscous_friction_nspm: 4.0}\n";
   test::StackWithoutPlant stack({LOGGER_PATH, SAFETY_PATH, CONTROLLER_PATH, ESTIMATOR_PATH}, url,
                                 log_path, with);
   ASSERT_TRUE(stack.started());
@@ -101,8 +108,8 @@ TEST_P(ForgedNominalStack, MillionNewtonNominalsForTheNextSample) {
       },
       15.0))
       << "the stack did not come up";
-  test::ChildProcess plant(
-      with({PLANT_SIM_PATH, "--mode", "lockstep", "--duration", std::to_string(kDurationS)}));
+  test::ChildProcess plant(with({PLANT_SIM_PATH, "--mode", "lockstep", "--duration",
+                                 std::to_string(kDurationS), "--truth", truth}));
   ASSERT_TRUE(plant.started());
 
   // Once a second from 2 s, then every sample from 5.0 s for 100 samples;
