@@ -39,12 +39,17 @@ usage: tools/launch.sh [options]
                         (default: 50 in real time when permitted, else 0 = normal scheduling)
   --loop-cpu N|auto|none  run those four on CPU N (auto: the last CPU when there are two
                         or more; none: let the scheduler place them)
+  --hosts FILE          start each process on its host (ip netns exec here, ssh in a
+                        deployment): docs/operations.md, "Several hosts"; needs --lcm-url
+                        with ttl=1
+  --check-network       check the bus (route, ttl, who hears whom; with --hosts, between
+                        every pair of hosts) and exit
 USAGE
 }
 
 PLANT=sim MODE="" SCENARIO=paper CONFIG="$ROOT/config/platform.yaml" VARIANT="" DURATION=""
 VIEWER=0 VIEWER_PORT="" LOG="" DO_LOG=1 DO_REPORT=1 SPY=0 URL="" OUT="" EMULATOR=0 BUILD_FIRST=1 LCM_LOGGER=0 RT_PRIORITY='' LOOP_CPU=auto
-TRUTH="" SEED=
+TRUTH="" SEED= HOSTS_FILE="" CHECK_NETWORK=0
 OVERLAYS=()
 ARGS="$*"
 while (($#)); do
@@ -73,6 +78,9 @@ while (($#)); do
     --lcm-logger) LCM_LOGGER=1 ;;
     --rt-priority) RT_PRIORITY=$2; shift ;;
     --loop-cpu) LOOP_CPU=$2; shift ;;
+    --hosts) [[ -f $2 ]] || { echo "launch: hosts file '$2' not found" >&2; exit 2; }
+             HOSTS_FILE=$(realpath "$2"); shift ;;
+    --check-network) CHECK_NETWORK=1 ;;
     -h|--help) usage; exit 0 ;;
     *) echo "launch: unknown option '$1'" >&2; usage >&2; exit 2 ;;
   esac
@@ -83,6 +91,43 @@ done
 if [[ -n $TRUTH && $PLANT == hw && $EMULATOR == 0 ]]; then
   echo "launch: --truth describes a simulated plant: use --plant sim or --device-emulator" >&2; exit 2
 fi
+# Where each process runs (--hosts): HOST_PREFIX[host] is the command that
+# starts a program on that host, PROCESS_HOST[process] its host; a process
+# the file does not name runs here.
+declare -A HOST_PREFIX=() PROCESS_HOST=()
+KNOWN_PROCESSES=" plant_sim hw_bridge hw_emulator estimator controller safety logger monitor lcm-spy viewer "
+if [[ -n $HOSTS_FILE ]]; then
+  line_no=0
+  while IFS= read -r line || [[ -n $line ]]; do
+    line_no=$((line_no + 1))
+    line=${line%%#*}
+    read -ra words <<<"$line"
+    ((${#words[@]})) || continue
+    where="launch: $HOSTS_FILE:$line_no"
+    case "${words[0]}" in
+      host) ((${#words[@]} >= 2)) || { echo "$where: 'host NAME [COMMAND PREFIX...]'" >&2; exit 2; }
+            HOST_PREFIX[${words[1]}]="${words[*]:2}" ;;
+      run) ((${#words[@]} == 3)) || { echo "$where: 'run PROCESS HOST'" >&2; exit 2; }
+           [[ $KNOWN_PROCESSES == *" ${words[1]} "* ]] ||
+             { echo "$where: unknown process '${words[1]}' (one of:$KNOWN_PROCESSES)" >&2; exit 2; }
+           [[ -n ${HOST_PREFIX[${words[2]}]+set} ]] ||
+             { echo "$where: host '${words[2]}' is not defined above ('host ${words[2]} ...')" >&2; exit 2; }
+           PROCESS_HOST[${words[1]}]=${words[2]} ;;
+      *) echo "$where: a line is 'host NAME PREFIX...' or 'run PROCESS HOST', not '${words[0]}'" >&2; exit 2 ;;
+    esac
+  done <"$HOSTS_FILE"
+  ((${#PROCESS_HOST[@]})) || { echo "launch: $HOSTS_FILE places no process ('run PROCESS HOST')" >&2; exit 2; }
+  # Across hosts the datagrams must pass one router hop at least, and the
+  # group is the user's choice for their network, never a default.
+  [[ -n $URL ]] || { echo "launch: --hosts needs --lcm-url (the group and port of your network, ttl=1)" >&2; exit 2; }
+  [[ $URL =~ [?\&]ttl=([1-9][0-9]*) ]] ||
+    { echo "launch: with --hosts the URL needs ttl=1 or more (ttl=0 keeps every datagram on its own host): $URL" >&2; exit 2; }
+fi
+on_host() { # process name: the words that start a program on its host (none: here)
+  local host=${PROCESS_HOST[$1]:-}
+  [[ -n $host ]] && echo "${HOST_PREFIX[$host]}"
+  return 0
+}
 if [[ $PLANT == hw && $MODE == lockstep ]]; then
   echo "launch: the real device cannot step in lockstep; use --realtime" >&2; exit 2
 fi
@@ -125,6 +170,56 @@ bin() { # path of a built program, or fail naming it
   [[ -n $p ]] || { echo "launch: program '$1' is not built in $BUILD" >&2; exit 1; }
   echo "$p"
 }
+# --check-network: is there a route for the group, does each host hear
+# every host (itself included: the loopback of multicast)? A missing route,
+# ttl=0 across hosts and a firewall rule are named; exit 0 when all hear all.
+check_network() {
+  local url=${URL:-udpm://239.255.76.67:7667?ttl=0}
+  local group=${url#udpm://}
+  group=${group%%[:?]*}
+  local ttl=0
+  [[ $url =~ [?\&]ttl=([0-9]+) ]] && ttl=${BASH_REMATCH[1]}
+  local hosts=(here) h prefix route dev ok=1 tmp
+  [[ -z $HOSTS_FILE ]] || mapfile -t hosts < <(printf '%s\n' "${!HOST_PREFIX[@]}" | sort)
+  tmp=$(mktemp -d)
+  echo "== network check: $url, hosts: ${hosts[*]} =="
+  if ((${#hosts[@]} > 1 && ttl == 0)); then
+    echo "  ttl=0 keeps every datagram on its own host: use ttl=1 in the URL"; ok=0
+  fi
+  for h in "${hosts[@]}"; do
+    prefix=()
+    [[ $h == here ]] || read -ra prefix <<<"${HOST_PREFIX[$h]}"
+    if ! route=$("${prefix[@]}" ip route get "$group" 2>&1); then
+      echo "  $h: no route for $group ($route): add one, e.g. 'ip route add 224.0.0.0/4 dev IFACE' (IFACE: the interface on the stack's network; lo for one machine)"
+      ok=0; continue
+    fi
+    dev=$(sed -n 's/.* dev \([^ ]*\).*/\1/p' <<<"$route" | head -n 1)
+    echo "  $h: $group leaves by ${dev:-?}"
+    if ((${#hosts[@]} > 1)) && [[ $dev == lo ]]; then echo "    lo never reaches another host"; ok=0; fi
+    "${prefix[@]}" "$(bin stewart_netcheck)" --lcm-url "$url" --id "$h" --duration-s 2 \
+      >"$tmp/$h.out" 2>"$tmp/$h.err" &
+  done
+  wait || true
+  local r s heard sent
+  for r in "${hosts[@]}"; do
+    [[ -f $tmp/$r.out ]] || continue
+    if [[ -s $tmp/$r.err ]]; then echo "  $r: $(head -n 1 "$tmp/$r.err")"; ok=0; continue; fi
+    for s in "${hosts[@]}"; do
+      sent=$(awk '$1 == "sent" { print $2 }' "$tmp/$s.out" 2>/dev/null)
+      heard=$(awk -v s="$s" '$1 == "heard" && $2 == s { print $3 }' "$tmp/$r.out")
+      echo "  $r hears $s: ${heard:-0} of ${sent:-?} probes"
+      if [[ -z $heard ]]; then ok=0; fi
+    done
+  done
+  if ((!ok)) && command -v iptables >/dev/null && iptables -S 2>/dev/null | grep -qE -- '-P INPUT DROP|-j (DROP|REJECT)'; then
+    echo "  a firewall rule drops packets here (iptables -S): allow UDP to the URL's port and IGMP"
+  fi
+  rm -rf "$tmp"
+  if ((ok)); then echo "network check: every host hears every host"; return 0; fi
+  echo "network check: FAILED (docs/operations.md, \"Several hosts\")"; return 1
+}
+if ((CHECK_NETWORK)); then check_network; exit $?; fi
+
 PLANT_SIM=$(bin plant_sim) ESTIMATOR=$(bin estimator) CONTROLLER=$(bin controller)
 SAFETY=$(bin safety) MONITOR=$(bin stewart_stack_monitor) LOGGER=$(bin stewart_logger)
 
@@ -176,12 +271,16 @@ else cp "$ROOT/config/scenarios/$SCENARIO.yaml" "$OUT/scenario.yaml"; fi
   echo "rt_priority: $RT_PRIORITY"
   echo "loop_cpu: $LOOP_CPU"
   echo "lcm_url: $URL"
+  [[ -z $HOSTS_FILE ]] || echo "hosts: $HOSTS_FILE"
   echo "command: tools/launch.sh $ARGS"
 } > "$OUT/run.yaml"
 
 echo "== Stewart stack: $PLANT, $MODE, scenario '$SCENARIO' ($DURATION s) =="
 echo "   run folder: $OUT"
 echo "   LCM URL:    $URL"
+if [[ -n $HOSTS_FILE ]]; then
+  for p in "${!PROCESS_HOST[@]}"; do echo "   host:       $p on ${PROCESS_HOST[$p]} (${HOST_PREFIX[${PROCESS_HOST[$p]}]:-here})"; done
+fi
 ((RT_PRIORITY > 0)) && echo "   scheduling: SCHED_FIFO $RT_PRIORITY for the loop's processes"
 [[ $LOOP_CPU != none ]] && echo "   loop CPU:   $LOOP_CPU (plant, estimator, controller, safety)"
 echo "   process logs: $OUT/<process>.log"
@@ -192,9 +291,14 @@ else
 fi
 
 PIDS=() NAMES=()
-start() { # name, command...
+start() { # name, command... (on the process's host with --hosts)
   local name=$1; shift
-  "$@" >"$OUT/$name.log" 2>&1 &
+  local prefix=()
+  read -ra prefix <<<"$(on_host "$name")"
+  # ssh hands its command to the remote shell as one string: quote each word
+  # (a URL's '?' and '&' must reach the program as they are).
+  if [[ ${prefix[0]:-} == ssh ]]; then set -- "$(printf '%q ' "$@")"; fi
+  "${prefix[@]}" "$@" >"$OUT/$name.log" 2>&1 &
   PIDS+=($!) NAMES+=("$name")
 }
 stop_all() {
@@ -255,7 +359,10 @@ SAFETY_ARGS=("${COMMON[@]}")
 start safety "${LOOP[@]}" "$SAFETY" "${SAFETY_ARGS[@]}"
 start controller "${LOOP[@]}" "$CONTROLLER" "${COMMON[@]}" --scenario "$SCENARIO"
 start estimator "${LOOP[@]}" "$ESTIMATOR" "${COMMON[@]}"
-"$MONITOR" "${COMMON[@]}" --wait-for safety,controller,estimator --timeout 15 ||
+WAIT_FOR=("$MONITOR" "${COMMON[@]}" --wait-for safety,controller,estimator --timeout 15)
+read -ra MONITOR_PREFIX <<<"$(on_host monitor)"
+[[ ${MONITOR_PREFIX[0]:-} != ssh ]] || WAIT_FOR=("$(printf '%q ' "${WAIT_FOR[@]}")")
+"${MONITOR_PREFIX[@]}" "${WAIT_FOR[@]}" ||
   { echo "launch: the stack did not come up" >&2; for n in safety controller estimator; do tail -n 5 "$OUT/$n.log" >&2; done; stop_all; exit 1; }
 
 # Only the plant reads the truth: the stack keeps the config's model.

@@ -30,7 +30,18 @@ constexpr int kMaxChannelLength = 63;  // LCM_MAX_CHANNEL_NAME_LENGTH
 // Far above any message of this stack; a corrupt header must not make us
 // allocate LCM's 256 MiB.
 constexpr uint32_t kMaxMessageBytes = 16u << 20;
+// Bounds on what messages in reassembly may hold, so that a flood of first
+// fragments that never complete costs neither memory nor the loop's time:
+// at most this many at once, this many declared bytes in all, and a message
+// whose fragments have not all come within this long lost one (LCM sends a
+// message's fragments back to back).
 constexpr size_t kMaxReassemblies = 4;
+constexpr uint64_t kMaxReassemblyBytes = uint64_t{32} << 20;
+constexpr int64_t kMaxReassemblyAgeUs = 500'000;
+// A call reads at most this many datagrams before it returns, so a flood
+// cannot keep the caller's loop from its own work; what is left is read at
+// the next call, in order.
+constexpr int kMaxDatagramsPerCall = 256;
 constexpr int kDefaultRecvBufBytes = 2 << 20;
 constexpr int kMaxDatagramBytes = 65536;
 
@@ -70,7 +81,12 @@ struct LcmReceiver::Reassembly {
   uint16_t sender_port = 0;
   uint32_t seqno = 0;
   std::string channel;  // from fragment 0
-  std::vector<uint8_t> data;
+  int64_t first_recv_utime = 0;
+  uint32_t size = 0;
+  // Not zeroed: only what the fragments wrote is ever read, and a message
+  // declaring 16 MiB must not cost 16 MiB of writes before its second
+  // fragment (the pages are touched only as fragments arrive).
+  std::unique_ptr<uint8_t[]> data;
   std::vector<bool> received;
   int remaining = 0;
 };
@@ -112,6 +128,10 @@ UdpmAddress ParseUdpmUrl(const std::string& url_in) {
     const size_t eq = pair.find('=');
     if (pair.substr(0, eq) == "recv_buf_size" && eq != std::string::npos) {
       a.recv_buf_size = ParseIntOrThrow(pair.substr(eq + 1), "recv_buf_size", url);
+    }
+    if (pair.substr(0, eq) == "ttl" && eq != std::string::npos) {
+      a.ttl = ParseIntOrThrow(pair.substr(eq + 1), "ttl", url);
+      if (a.ttl > 255) throw std::invalid_argument("LCM URL '" + url + "': ttl above 255");
     }
   }
   return a;
@@ -200,7 +220,7 @@ int LcmReceiver::HandleTimeoutUs(int64_t timeout_us) {
   if (ready < 0) return errno == EINTR ? 0 : -1;
   if (ready == 0) return 0;
   int handled = 0;
-  for (;;) {
+  for (int read = 0; read < kMaxDatagramsPerCall; ++read) {
     sockaddr_in from{};
     iovec vec{datagram_.data(), datagram_.size()};
     alignas(cmsghdr) char control[CMSG_SPACE(sizeof(timeval))];
@@ -280,55 +300,76 @@ int LcmReceiver::HandleDatagram(const uint8_t* data, int size, uint32_t sender_i
     ++counters_.bad_datagrams;
     return 0;
   }
-  Reassembly* r = nullptr;
-  for (auto& candidate : reassemblies_) {
-    if (candidate->sender_ip == sender_ip && candidate->sender_port == sender_port &&
-        candidate->seqno == seqno) {
-      r = candidate.get();
+  // Messages whose fragments stopped coming are given up first.
+  for (size_t i = 0; i < reassemblies_.size();) {
+    if (recv_utime - reassemblies_[i]->first_recv_utime > kMaxReassemblyAgeUs) {
+      DropReassembly(i);
+    } else {
+      ++i;
     }
   }
-  if (r != nullptr && (r->data.size() != msg_size || r->received.size() != fragments)) {
-    r = nullptr;  // a different message under a reused sequence number
-    for (auto it = reassemblies_.begin(); it != reassemblies_.end(); ++it) {
-      if ((*it)->sender_ip == sender_ip && (*it)->sender_port == sender_port &&
-          (*it)->seqno == seqno) {
-        reassemblies_.erase(it);
-        ++counters_.incomplete_fragmented;
-        break;
-      }
+  size_t index = reassemblies_.size();
+  for (size_t i = 0; i < reassemblies_.size(); ++i) {
+    const Reassembly& candidate = *reassemblies_[i];
+    if (candidate.sender_ip == sender_ip && candidate.sender_port == sender_port &&
+        candidate.seqno == seqno) {
+      index = i;
     }
   }
-  if (r == nullptr) {
-    if (reassemblies_.size() >= kMaxReassemblies) {
-      reassemblies_.erase(reassemblies_.begin());  // the oldest lost a fragment
-      ++counters_.incomplete_fragmented;
+  if (index < reassemblies_.size() && (reassemblies_[index]->size != msg_size ||
+                                       reassemblies_[index]->received.size() != fragments)) {
+    DropReassembly(index);  // a different message under a reused sequence number
+    index = reassemblies_.size();
+  }
+  if (index == reassemblies_.size()) {
+    // As LCM: a message starts with its fragment 0, which names the channel.
+    if (fragment_no != 0) {
+      ++counters_.orphan_fragments;
+      return 0;
+    }
+    if (!all_ && !Subscribed(channel)) return 0;  // not ours (the kernel filter may be off)
+    while (!reassemblies_.empty() && (reassemblies_.size() >= kMaxReassemblies ||
+                                      reassembly_bytes_ + msg_size > kMaxReassemblyBytes)) {
+      DropReassembly(0);  // the oldest
     }
     auto fresh = std::make_unique<Reassembly>();
     fresh->sender_ip = sender_ip;
     fresh->sender_port = sender_port;
     fresh->seqno = seqno;
-    fresh->data.resize(msg_size);
+    fresh->channel = channel;
+    fresh->first_recv_utime = recv_utime;
+    fresh->size = msg_size;
+    fresh->data.reset(new uint8_t[msg_size]);
     fresh->received.assign(fragments, false);
     fresh->remaining = fragments;
-    r = fresh.get();
+    reassembly_bytes_ += msg_size;
     reassemblies_.push_back(std::move(fresh));
+    index = reassemblies_.size() - 1;  // the evictions above moved the end
   }
-  if (r->received[fragment_no]) return 0;  // a duplicate
-  r->received[fragment_no] = true;
-  --r->remaining;
-  if (fragment_no == 0) r->channel = channel;
-  std::memcpy(r->data.data() + fragment_offset, payload, static_cast<size_t>(payload_size));
-  if (r->remaining > 0) return 0;
+  Reassembly& r = *reassemblies_[index];
+  if (r.received[fragment_no]) return 0;  // a duplicate
+  r.received[fragment_no] = true;
+  --r.remaining;
+  std::memcpy(r.data.get() + fragment_offset, payload, static_cast<size_t>(payload_size));
+  if (r.remaining > 0) return 0;
   // Complete: take it out of the list before delivering.
-  std::unique_ptr<Reassembly> done;
-  for (auto it = reassemblies_.begin(); it != reassemblies_.end(); ++it) {
-    if (it->get() == r) {
-      done = std::move(*it);
-      reassemblies_.erase(it);
-      break;
-    }
+  std::unique_ptr<Reassembly> done = std::move(reassemblies_[index]);
+  reassemblies_.erase(reassemblies_.begin() + static_cast<std::ptrdiff_t>(index));
+  reassembly_bytes_ -= done->size;
+  return Deliver(done->channel.c_str(), done->data.get(), msg_size, recv_utime);
+}
+
+void LcmReceiver::DropReassembly(size_t index) {
+  reassembly_bytes_ -= reassemblies_[index]->size;
+  reassemblies_.erase(reassemblies_.begin() + static_cast<std::ptrdiff_t>(index));
+  ++counters_.incomplete_fragmented;
+}
+
+bool LcmReceiver::Subscribed(const std::string& channel) const {
+  for (const Subscription& s : subscriptions_) {
+    if (s.channel == channel) return true;
   }
-  return Deliver(done->channel.c_str(), done->data.data(), msg_size, recv_utime);
+  return false;
 }
 
 int LcmReceiver::Deliver(const char* channel, const uint8_t* data, uint32_t size,

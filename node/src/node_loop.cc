@@ -10,6 +10,8 @@ namespace stewart {
 void ReportReceiverCounters(const LcmReceiver& receiver, HealthReporter* health) {
   health->SetCounter("rx_bad", receiver.counters().bad_datagrams);
   health->SetCounter("rx_decode_fail", receiver.counters().decode_failures);
+  health->SetCounter("rx_incomplete", receiver.counters().incomplete_fragmented);
+  health->SetCounter("rx_orphan_fragments", receiver.counters().orphan_fragments);
 }
 
 ExitCode RunNodeLoop(const std::string& name, lcm::LCM* lcm, LcmReceiver* receiver,

@@ -1,6 +1,7 @@
 // The nodes' LCM receiver: URL parsing, the kernel channel filter on a real
 // socket, and end to end against lcm::LCM publishing short and fragmented
-// messages, with hostile datagrams in between. Private LCM ports 7801-7804.
+// messages, with hostile datagrams in between. Private LCM ports 7801-7804
+// and 8001.
 #include "stewart/node/lcm_receiver.h"
 
 #include <arpa/inet.h>
@@ -10,7 +11,9 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <chrono>
+#include <cstdio>
 #include <cstring>
 #include <stdexcept>
 #include <string>
@@ -21,6 +24,7 @@
 #include "stewart/health_t.hpp"
 #include "stewart/node/channel_filter.h"
 #include "stewart/node/lcm_handle.h"
+#include "stewart/node/raw_bus_sender.h"
 
 namespace stewart {
 namespace {
@@ -117,12 +121,28 @@ TEST(LcmChannelFilter, PassesExactlyTheSubscribedChannelsAndEveryFragment) {
   s.Send(ShortDatagram("", 8));                     // drop
   std::vector<uint8_t> fragment = {'L', 'C', '0', '3'};
   fragment.resize(40, 1);
-  s.Send(fragment);               // fragments always pass
+  s.Send(fragment);               // a later fragment (number 257) always passes
   s.Send(ShortDatagram("A", 0));  // a short one at the end of the datagram
+  // First fragments name their channel: they pass only for a subscribed one.
+  const auto first = [](const std::string& channel, size_t bytes) {
+    return LcmFragmentDatagram(9, 100000, 0, 0, 72, channel, std::vector<uint8_t>(bytes, 2));
+  };
+  s.Send(first("STEWART_SENSORS", 11));                                                  // pass
+  s.Send(first("STEWART_SENSORS_X", 12));                                                // drop
+  s.Send(first("NOT_OURS", 13));                                                         // drop
+  s.Send(first("A", 14));                                                                // pass
+  s.Send(LcmFragmentDatagram(9, 100000, 1400, 1, 72, "", std::vector<uint8_t>(15, 2)));  // pass
+  s.Send({'X', 'Y', 'Z', '!', 0, 0, 0, 1, 2});  // not LCM: passes, for the receiver to count
   const std::vector<size_t> sizes = s.Drain();
-  const std::vector<size_t> expected = {
-      ShortDatagram("STEWART_SENSORS", 1).size(), ShortDatagram("A", 4).size(),
-      ShortDatagram("STEWART_CMD_SAFE", 6).size(), fragment.size(), ShortDatagram("A", 0).size()};
+  const std::vector<size_t> expected = {ShortDatagram("STEWART_SENSORS", 1).size(),
+                                        ShortDatagram("A", 4).size(),
+                                        ShortDatagram("STEWART_CMD_SAFE", 6).size(),
+                                        fragment.size(),
+                                        ShortDatagram("A", 0).size(),
+                                        first("STEWART_SENSORS", 11).size(),
+                                        first("A", 14).size(),
+                                        20 + 15,
+                                        9};
   EXPECT_EQ(sizes, expected);
 }
 
@@ -276,13 +296,16 @@ TEST(LcmReceiver, CountsHostileDatagramsAndKeepsWorking) {
   BusSender bus(7803);
   std::vector<uint8_t> truncated_command = ShortDatagram("CMD", 3);  // too short to decode
   bus.Send(truncated_command);
-  bus.Send(Fragment(1, 1u << 30, 0, 0, 2, {'C', 'M', 'D', 0}));        // absurd size
-  bus.Send(Fragment(2, 100, 90, 1, 2, std::vector<uint8_t>(20, 0)));   // past the end
-  bus.Send(Fragment(3, 100, 0, 3, 2, {}));                             // number >= count
+  bus.Send(Fragment(1, 1u << 30, 0, 0, 2, {'C', 'M', 'D', 0}));       // absurd size
+  bus.Send(Fragment(2, 100, 90, 1, 2, std::vector<uint8_t>(20, 0)));  // past the end
+  bus.Send(Fragment(3, 100, 0, 3, 2, {}));                            // number >= count
+  // Two the kernel filter drops (no channel of ours can be read in them):
   bus.Send(Fragment(4, 100, 0, 0, 2, std::vector<uint8_t>(10, 'Z')));  // unterminated channel
   bus.Send({'L', 'C', '0', '3', 1, 2});                                // truncated header
-  // The fragment of a message that never completes, then a good message.
+  // The fragment of a message that never completes, a later fragment of a
+  // message whose first never came, then a good message.
   bus.Send(Fragment(5, 1000, 0, 0, 2, {'C', 'M', 'D', 0, 1, 2, 3}));
+  bus.Send(Fragment(6, 1000, 500, 1, 2, std::vector<uint8_t>(500, 7)));
   auto lcm = MakeLcm(url);
   force_command_t command{};
   command.seq = 42;
@@ -290,8 +313,67 @@ TEST(LcmReceiver, CountsHostileDatagramsAndKeepsWorking) {
   PumpUntil(&receiver, [&] { return !sink.seqs.empty(); });
   ASSERT_EQ(sink.seqs.size(), 1u);
   EXPECT_EQ(sink.seqs[0], 42);
+  ASSERT_TRUE(receiver.kernel_filter_attached());
   EXPECT_EQ(receiver.counters().decode_failures, 1);
-  EXPECT_EQ(receiver.counters().bad_datagrams, 5);
+  EXPECT_EQ(receiver.counters().bad_datagrams, 3);
+  EXPECT_EQ(receiver.counters().orphan_fragments, 1);
+}
+
+// A flood of first fragments, each declaring a 16 MiB message (1000 per
+// second for 2 s, on a subscribed and on an unsubscribed channel), while good
+// messages keep coming every 10 ms: no call to HandleTimeout may hold the
+// caller's loop for long, every good message arrives, and what was given up
+// is counted. (Before the reassembly bounds, each such fragment allocated and
+// zeroed its declared 16 MiB: one call read the whole backlog, 0.4-2 s.)
+TEST(LcmReceiver, AFloodOfHugeFragmentsNeitherStallsTheLoopNorLosesGoodMessages) {
+  const std::string url = PrivateLcmUrl(8001);
+  LcmReceiver receiver(url);
+  Sink sink;
+  receiver.Subscribe("CMD", &Sink::OnCommand, &sink);
+  RawBusSender bus(url);
+  auto lcm = MakeLcm(url);
+  constexpr int kFloodPerSecond = 1000;
+  constexpr double kFloodSeconds = 2.0;
+  constexpr uint32_t kDeclaredBytes = 16u << 20;
+  constexpr int kGoodMessages = 200;  // every 10 ms over the flood
+  std::atomic<bool> sending{true};
+  std::thread sender([&] {
+    const auto start = std::chrono::steady_clock::now();
+    const int total = static_cast<int>(kFloodPerSecond * kFloodSeconds);
+    force_command_t command{};
+    int good = 0;
+    for (int i = 0; i < total; ++i) {
+      std::this_thread::sleep_until(start +
+                                    std::chrono::microseconds(i * 1000000 / kFloodPerSecond));
+      const std::string channel = i % 2 == 0 ? "CMD" : "NOT_SUBSCRIBED";
+      bus.Send(LcmFragmentDatagram(static_cast<uint32_t>(1000 + i), kDeclaredBytes, 0, 0, 12000,
+                                   channel, std::vector<uint8_t>(1200, 0xab)));
+      if (i % 10 == 0 && good < kGoodMessages) {
+        command.seq = good++;
+        lcm->publish("CMD", &command);
+      }
+    }
+    sending = false;
+  });
+  double longest_call_ms = 0.0;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+  while ((sending || sink.seqs.size() < kGoodMessages) &&
+         std::chrono::steady_clock::now() < deadline) {
+    const auto t0 = std::chrono::steady_clock::now();
+    receiver.HandleTimeout(5);
+    const double ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    longest_call_ms = std::max(longest_call_ms, ms);
+  }
+  sender.join();
+  std::printf("[flood] longest HandleTimeout(5 ms) call %.1f ms; good %zu/%d; incomplete %lld\n",
+              longest_call_ms, sink.seqs.size(), kGoodMessages,
+              static_cast<long long>(receiver.counters().incomplete_fragmented));
+  EXPECT_EQ(sink.seqs.size(), static_cast<size_t>(kGoodMessages));
+  // A control loop at 1 kHz must get its thread back within a few periods.
+  EXPECT_LT(longest_call_ms, 25.0);
+  // Every flooded message that started a reassembly was given up, counted.
+  EXPECT_GT(receiver.counters().incomplete_fragmented, 0);
 }
 
 }  // namespace

@@ -80,6 +80,11 @@ int Shell(const std::string& command) {
 
 LaunchResult RunLauncher(const std::string& args, int lcm_port, const std::string& run_dir,
                          const std::string& output_path) {
+  return RunLauncherOnUrl(args, PrivateLcmUrl(lcm_port), run_dir, output_path);
+}
+
+LaunchResult RunLauncherOnUrl(const std::string& args, const std::string& url,
+                              const std::string& run_dir, const std::string& output_path) {
   LaunchResult launch;
   launch.output_path = output_path;
   const auto start = std::chrono::steady_clock::now();
@@ -88,8 +93,8 @@ LaunchResult RunLauncher(const std::string& args, int lcm_port, const std::strin
             " && STEWART_BUILD_DIR=" + ShellQuote(STEWART_BUILD_DIR) + " flock " +
             ShellQuote(std::string(STEWART_BUILD_DIR) + "/stack_launch.lock") + " timeout -k 30 " +
             std::to_string(kLaunchTimeoutS) + " tools/launch.sh " + args + " --out " +
-            ShellQuote(run_dir) + " --lcm-url " + ShellQuote(PrivateLcmUrl(lcm_port)) + " >" +
-            ShellQuote(output_path) + " 2>&1");
+            ShellQuote(run_dir) + " --lcm-url " + ShellQuote(url) + " >" + ShellQuote(output_path) +
+            " 2>&1");
   launch.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return launch;
 }

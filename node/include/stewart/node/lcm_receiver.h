@@ -39,6 +39,7 @@ struct UdpmAddress {
   std::string group = "239.255.76.67";
   int port = 7667;
   int recv_buf_size = 0;  ///< bytes; 0 = the receiver's default
+  int ttl = 0;            ///< multicast TTL of what is sent (LCM's default, 0: this host)
 };
 
 /// Parses "udpm://GROUP[:PORT][?key=value&...]" (an empty URL means
@@ -51,7 +52,9 @@ struct LcmReceiverCounters {
   int64_t messages = 0;               ///< complete messages handed to a subscriber
   int64_t decode_failures = 0;        ///< subscribed messages whose decode() failed
   int64_t bad_datagrams = 0;          ///< not LCM, truncated, bad fragments
-  int64_t incomplete_fragmented = 0;  ///< fragmented messages given up (a fragment lost)
+  int64_t incomplete_fragmented = 0;  ///< fragmented messages given up (a fragment lost, too
+                                      ///< old, or no room: see lcm_receiver.cc's bounds)
+  int64_t orphan_fragments = 0;       ///< later fragments of a message whose first was not kept
 };
 
 class LcmReceiver {
@@ -87,8 +90,10 @@ class LcmReceiver {
   void SubscribeAll(RawHandler handler);
 
   /// Waits up to timeout_ms (0: do not wait) for the socket, then handles
-  /// every datagram already queued. Returns the number of messages handed
-  /// to subscribers (0 on timeout), or -1 on a receive error.
+  /// the datagrams already queued, at most 256 per call (a flood must not
+  /// hold the caller's loop; the rest wait for the next call, in order).
+  /// Returns the number of messages handed to subscribers (0 on timeout),
+  /// or -1 on a receive error.
   int HandleTimeout(int timeout_ms);
   /// The same with a microsecond timeout (ppoll), for loops paced to a
   /// deadline: the wait ends when a datagram arrives, not at the next ms.
@@ -114,13 +119,16 @@ class LcmReceiver {
   int HandleDatagram(const uint8_t* data, int size, uint32_t sender_ip, uint16_t sender_port,
                      int64_t recv_utime);
   int Deliver(const char* channel, const uint8_t* data, uint32_t size, int64_t recv_utime);
+  void DropReassembly(size_t index);  // counted as incomplete
+  bool Subscribed(const std::string& channel) const;
 
   int fd_ = -1;
   std::vector<Subscription> subscriptions_;
   RawHandler all_;  // set: every channel
   std::string channel_scratch_;
   std::vector<uint8_t> datagram_;
-  std::vector<std::unique_ptr<Reassembly>> reassemblies_;
+  std::vector<std::unique_ptr<Reassembly>> reassemblies_;  // oldest first
+  uint64_t reassembly_bytes_ = 0;                          // their declared sizes
   LcmReceiverCounters counters_;
   bool filter_attached_ = false;
 };

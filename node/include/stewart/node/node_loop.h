@@ -16,8 +16,11 @@ namespace stewart {
 /// receive error reports FAULT and returns kFault; a clean stop reports
 /// STOPPED and returns kOk. A stop signal interrupting the wait (EINTR) is a clean stop.
 /// Puts the receiver's counts of unusable input into the heartbeat:
-/// rx_bad (datagrams that are not valid LCM) and rx_decode_fail (messages
-/// on a subscribed channel that did not decode as its type).
+/// rx_bad (datagrams that are not valid LCM), rx_decode_fail (messages
+/// on a subscribed channel that did not decode as its type),
+/// rx_incomplete (fragmented messages given up: a fragment lost, too old, or
+/// no room under the receiver's bounds) and rx_orphan_fragments (fragments
+/// of a message whose first fragment was not kept).
 void ReportReceiverCounters(const LcmReceiver& receiver, HealthReporter* health);
 
 ExitCode RunNodeLoop(const std::string& name, lcm::LCM* lcm, LcmReceiver* receiver,

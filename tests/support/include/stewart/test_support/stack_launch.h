@@ -52,6 +52,11 @@ struct LaunchResult {
 LaunchResult RunLauncher(const std::string& args, int lcm_port, const std::string& run_dir,
                          const std::string& output_path);
 
+/// The same on `url` (a URL of the test's own, e.g. with ttl=1 on a
+/// network-namespace lab).
+LaunchResult RunLauncherOnUrl(const std::string& args, const std::string& url,
+                              const std::string& run_dir, const std::string& output_path);
+
 /// Holds the launcher lock of this build folder (<build>/stack_launch.lock)
 /// while a test runs a stack of its own, so that no two stacks share the 2
 /// cores (RunLauncher takes the same lock).

@@ -1,0 +1,198 @@
+// stewart_inject: puts hostile traffic on a running stack's bus, for the
+// fault-injection tests and for soak runs by hand (docs/operations.md,
+// "Faults on the bus").
+//
+//   stewart_inject --mode fragment-flood [--channel NAME]... --rate-hz 1000 --duration-s 2
+//       first fragments, each declaring --declared-bytes (16 MiB), that never
+//       complete
+//   stewart_inject --mode garbage ...        short datagrams of random bytes
+//   stewart_inject --mode truncate|wrong-fingerprint|duplicate|stale|future ...
+//       each message heard on the channels, sent again changed: cut short,
+//       the type's fingerprint flipped, as it was, its utime moved back or
+//       forward by --shift-s (every message of the stack starts with int64
+//       utime, right after the 8-byte fingerprint)
+//
+// Without --channel: every channel of the config. Sends to the config's URL
+// (--lcm-url) with its TTL. Prints one line: what was sent. Exit 0, 2 on a
+// bad flag.
+#include <spdlog/spdlog.h>
+
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <map>
+#include <random>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "stewart/node/lcm_receiver.h"
+#include "stewart/node/node_main.h"
+#include "stewart/node/raw_bus_sender.h"
+#include "stewart/node/stop_signal.h"
+
+namespace stewart {
+namespace {
+
+enum class Mode {
+  kFragmentFlood,
+  kGarbage,
+  kTruncate,
+  kWrongFingerprint,
+  kDuplicate,
+  kStale,
+  kFuture
+};
+
+const std::map<std::string, Mode> kModes = {
+    {"fragment-flood", Mode::kFragmentFlood},
+    {"garbage", Mode::kGarbage},
+    {"truncate", Mode::kTruncate},
+    {"wrong-fingerprint", Mode::kWrongFingerprint},
+    {"duplicate", Mode::kDuplicate},
+    {"stale", Mode::kStale},
+    {"future", Mode::kFuture},
+};
+
+struct Options {
+  Mode mode = Mode::kGarbage;
+  std::vector<std::string> channels;
+  double rate_hz = 1000.0;
+  double duration_s = 2.0;
+  uint32_t declared_bytes = 16u << 20;
+  double shift_s = 10.0;
+  uint32_t seed = 1;
+};
+
+constexpr int kFingerprintBytes = 8;
+constexpr int kUtimeBytes = 8;
+
+/// A message heard on the bus, changed as `mode` asks; empty when the
+/// message is too short to carry a fingerprint and a utime.
+std::vector<uint8_t> Mutate(Mode mode, const uint8_t* data, size_t size, double shift_s,
+                            std::mt19937* rng) {
+  std::vector<uint8_t> payload(data, data + size);
+  if (size < kFingerprintBytes + kUtimeBytes) return {};
+  switch (mode) {
+    case Mode::kTruncate: {
+      std::uniform_int_distribution<size_t> cut(0, size - 1);
+      payload.resize(cut(*rng));
+      break;
+    }
+    case Mode::kWrongFingerprint:
+      for (int i = 0; i < kFingerprintBytes; ++i) payload[static_cast<size_t>(i)] ^= 0x5a;
+      break;
+    case Mode::kStale:
+    case Mode::kFuture: {
+      int64_t utime = 0;
+      for (int i = 0; i < kUtimeBytes; ++i) utime = (utime << 8) | payload[kFingerprintBytes + i];
+      const auto shift_us = static_cast<int64_t>(shift_s * 1e6);
+      utime += mode == Mode::kStale ? -shift_us : shift_us;
+      for (int i = kUtimeBytes - 1; i >= 0; --i) {
+        payload[static_cast<size_t>(kFingerprintBytes + i)] = static_cast<uint8_t>(utime);
+        utime >>= 8;
+      }
+      break;
+    }
+    default:
+      break;  // duplicate: as it was
+  }
+  return payload;
+}
+
+ExitCode Run(const StackConfig& config, const Options& options) {
+  std::vector<std::string> channels = options.channels;
+  if (channels.empty()) {
+    for (const ChannelField& field : kChannelFields)
+      channels.push_back(config.lcm.channels.*field.member);
+  }
+  RawBusSender bus(config.lcm.url);
+  std::mt19937 rng(options.seed);
+  const auto start = std::chrono::steady_clock::now();
+  const auto end = start + std::chrono::duration<double>(options.duration_s);
+  const auto period = std::chrono::duration<double>(1.0 / options.rate_hz);
+  int64_t sent = 0, failed = 0;
+  uint32_t seqno = rng();
+  auto send = [&](const std::vector<uint8_t>& datagram) {
+    if (bus.Send(datagram)) {
+      ++sent;
+    } else {
+      ++failed;
+    }
+  };
+  const bool from_bus = options.mode != Mode::kFragmentFlood && options.mode != Mode::kGarbage;
+  if (!from_bus) {
+    for (int64_t i = 0; !StopRequested(); ++i) {
+      const auto at = start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                  period * static_cast<double>(i));
+      if (at >= end) break;
+      std::this_thread::sleep_until(at);
+      const std::string& channel = channels[static_cast<size_t>(i) % channels.size()];
+      if (options.mode == Mode::kFragmentFlood) {
+        // The first of many fragments; the rest never come.
+        const uint16_t fragments =
+            static_cast<uint16_t>(std::min<uint32_t>(65535, options.declared_bytes / 1400 + 1));
+        send(LcmFragmentDatagram(seqno++, options.declared_bytes, 0, 0, fragments, channel,
+                                 std::vector<uint8_t>(1400, 0xab)));
+      } else {
+        std::uniform_int_distribution<int> length(0, 512);
+        std::vector<uint8_t> payload(static_cast<size_t>(length(rng)));
+        for (uint8_t& b : payload) b = static_cast<uint8_t>(rng());
+        send(LcmShortDatagram(seqno++, channel, payload));
+      }
+    }
+  } else {
+    // Changes what it hears, at most rate_hz messages a second.
+    LcmReceiver receiver(config.lcm.url);
+    std::map<std::string, bool> wanted;
+    for (const std::string& c : channels) wanted[c] = true;
+    auto next_allowed = start;
+    receiver.SubscribeAll([&](const lcm::ReceiveBuffer& rbuf, const std::string& channel) {
+      if (!wanted.count(channel)) return;
+      const auto now = std::chrono::steady_clock::now();
+      if (now < next_allowed) return;
+      next_allowed = now + std::chrono::duration_cast<std::chrono::steady_clock::duration>(period);
+      const std::vector<uint8_t> payload =
+          Mutate(options.mode, static_cast<const uint8_t*>(rbuf.data), rbuf.data_size,
+                 options.shift_s, &rng);
+      if (payload.empty() && options.mode != Mode::kTruncate) return;
+      send(LcmShortDatagram(seqno++, channel, payload));
+    });
+    while (!StopRequested() && std::chrono::steady_clock::now() < end) receiver.HandleTimeout(10);
+  }
+  std::printf("stewart_inject: %lld datagrams sent (%lld refused by the kernel) on %zu channels\n",
+              static_cast<long long>(sent), static_cast<long long>(failed), channels.size());
+  std::fflush(stdout);
+  return ExitCode::kOk;
+}
+
+}  // namespace
+}  // namespace stewart
+
+int main(int argc, char** argv) {
+  using namespace stewart;
+  auto options = std::make_shared<Options>();
+  return NodeMain(
+      argc, argv,
+      {"inject", "puts hostile traffic on the bus (fault injection; docs/operations.md)"},
+      [options](CLI::App& app) {
+        app.add_option("--mode", options->mode, "what to send")
+            ->transform(CLI::CheckedTransformer(kModes, CLI::ignore_case))
+            ->required();
+        app.add_option("--channel", options->channels,
+                       "a channel to attack (repeatable; default: every channel of the config)");
+        app.add_option("--rate-hz", options->rate_hz, "datagrams (or changed messages) per second")
+            ->check(CLI::Range(1.0, 100000.0));
+        app.add_option("--duration-s", options->duration_s, "how long")
+            ->check(CLI::Range(0.0, 3600.0));
+        app.add_option("--declared-bytes", options->declared_bytes,
+                       "fragment-flood: the size each message declares")
+            ->check(CLI::Range(1u, 1u << 30));
+        app.add_option("--shift-s", options->shift_s, "stale/future: how far utime moves")
+            ->check(CLI::Range(0.0, 1e9));
+        app.add_option("--seed", options->seed, "random seed (garbage, truncate)");
+      },
+      nullptr, [options](const StackConfig& config, lcm::LCM*) { return Run(config, *options); });
+}
