@@ -8,6 +8,7 @@
 #include "stewart/common/check.h"
 #include "stewart/model/linear_algebra6.h"
 #include "stewart/safety/nominal_bound.h"
+#include "stewart/safety/pose_plausibility.h"
 
 namespace stewart::safety {
 namespace {
@@ -144,7 +145,10 @@ Vector6d SafetyFilter::StepWithTerms(const DynamicsTerms& terms, const Vector6d&
   d->f_des = f_des;
   d->compute_ns = 0;
 
-  const bool state_valid = StateAndTermsFinite(q, qd, terms);
+  // A finite pose the platform cannot be in (pose_plausibility.h) is as
+  // invalid as a NaN: its model terms are numbers without meaning.
+  const bool state_valid = StateAndTermsFinite(q, qd, terms) &&
+                           PoseProblems(platform_, q, terms.leg_length_m) == kPosePlausible;
   // NaN compares false: this also rejects non-finite entries.
   // A non-finite disturbance estimate is an invalid state, like a NaN in q.
   const bool disturbance_valid =
@@ -251,13 +255,16 @@ Vector6d SafetyFilter::SafeStopCommand(const Vector6d& q, const Vector6d& qd,
   *d = SafetyDiagnostics{};
   d->variant = variant_;
   DynamicsTerms& terms = workspace_.terms;
-  const bool state_valid = q.allFinite() && qd.allFinite();
-  if (state_valid) EvaluateDynamics(platform_, q, qd, &terms);
+  bool state_valid = q.allFinite() && qd.allFinite();
+  if (state_valid) {
+    EvaluateDynamics(platform_, q, qd, &terms);
+    state_valid =
+        terms.M.allFinite() && PoseProblems(platform_, q, terms.leg_length_m) == kPosePlausible;
+  }
   d->filter_case = FilterCase::kFallback;
   d->flags = kFlagFallback;
   const bool use_d = use_disturbance_ && disturbance.force_n.allFinite();
-  d->f_safe = SafeStop(terms, qd, state_valid && terms.M.allFinite(),
-                       use_d ? disturbance.force_n : kNoDisturbance);
+  d->f_safe = SafeStop(terms, qd, state_valid, use_d ? disturbance.force_n : kNoDisturbance);
   return d->f_safe;
 }
 
@@ -447,7 +454,21 @@ void SafetyFilter::SolveReference(const StepInput& in, FilterWorkspace* ws,
   const Eigen::Vector2d mu = g.colPivHouseholderQr().solve(y - qp.x0);
   d->mu_p = mu.allFinite() ? std::fmax(mu(0), 0.0) : 0.0;
   d->mu_v = mu.allFinite() ? std::fmax(mu(1), 0.0) : 0.0;
+  // A condition whose share of the correction is of rounding size (the least
+  // squares recovers ~1e-16 for a row the solver left inactive) is not
+  // active: the same tolerance as the flag, in the metric's coordinates.
+  const double rounding = kReferenceActiveRelTol * std::fmax(qp.x0.norm(), 1.0);
+  if (d->mu_p * problem.g_p.norm() <= rounding) d->mu_p = 0.0;
+  if (d->mu_v * problem.g_v.norm() <= rounding) d->mu_v = 0.0;
   d->f_safe = ForceFromQpSolution(ws->metric_map, y);
+  // The solver's tolerances and the round trip F = T (T^-1 F_nom) leave a
+  // correction of rounding size on states no condition cuts: that is F_nom
+  // itself, not an intervention (flag "active", docs/safety.md "QP reference").
+  const Vector6d correction = d->f_safe - in.f_des;
+  if (correction.norm() <= kReferenceActiveRelTol * std::fmax(in.f_des.norm(), 1.0)) {
+    d->f_safe = in.f_des;
+    d->mu_p = d->mu_v = 0.0;
+  }
   ReportQpSolution(nullptr, d);  // the reference solver gives no row multipliers
 }
 
