@@ -46,10 +46,20 @@ TwoConstraintProblem MakeProblem(const ConstraintSet& c, const BarrierEvaluation
   return p;
 }
 
+// Solves H X = B in place; false when H is singular or so nearly singular
+// that the solve amplifies B by more than kMaxLegJacobianCondition
+// (||H|| ||X|| / ||B|| <= cond(H)). Costs two norms on the steps that solve.
+template <int Cols>
+bool SolveWithLegJacobian(const Matrix6d& h, Eigen::Matrix<double, 6, Cols>* b) {
+  const double rhs_norm = b->norm();
+  if (!SolvePartialPivot6(h, b)) return false;
+  return h.norm() * b->norm() <= kMaxLegJacobianCondition * rhs_norm;
+}
+
 // T = H^-1 L_M given the factor of M; false (T NaN) when H is singular.
 bool AccelerationMetricMap(const Matrix6d& h, const Cholesky6& inertia, Matrix6d* map) {
   *map = inertia.MatrixL();
-  if (SolvePartialPivot6(h, map)) return true;
+  if (SolveWithLegJacobian(h, map)) return true;
   map->setConstant(NAN);
   return false;
 }
@@ -144,6 +154,7 @@ Vector6d SafetyFilter::StepWithTerms(const DynamicsTerms& terms, const Vector6d&
   d->mu_force.setZero();
   d->f_des = f_des;
   d->compute_ns = 0;
+  workspace_.leg_jacobian_degenerate = false;
 
   // A finite pose the platform cannot be in (pose_plausibility.h) is as
   // invalid as a NaN: its model terms are numbers without meaning.
@@ -223,10 +234,13 @@ Vector6d SafetyFilter::StepWithTerms(const DynamicsTerms& terms, const Vector6d&
     d->mu_position.fill(0.0);
     d->mu_velocity.fill(0.0);
     d->mu_force.setZero();
+    // A singular configuration (H) is an implausible pose: invalid input,
+    // and no hold brake, which would solve with that H.
+    const bool valid = input_valid && !ws.leg_jacobian_degenerate;
     d->filter_case = FilterCase::kFallback;
-    d->flags |= kFlagFallback | (input_valid ? kFlagInfeasible : kFlagInvalidInput);
-    d->infeasible = input_valid;
-    d->f_safe = SafeStop(terms, qd, state_valid, held_disturbance);
+    d->flags |= kFlagFallback | (valid ? kFlagInfeasible : kFlagInvalidInput);
+    d->infeasible = valid;
+    d->f_safe = SafeStop(terms, qd, state_valid && valid, held_disturbance);
   }
   FinishStep(f_des, d);
   return d->f_safe;
@@ -275,7 +289,11 @@ Vector6d SafetyFilter::SafeStop(const DynamicsTerms& terms, const Vector6d& qd, 
     // Gravity-compensating brake: qdd = -qd / stop_time_s, against the
     // estimated model error too (a payload would otherwise sink).
     f = InverseDynamics(terms, -qd / stop_time_s_, disturbance_n);
-    if (!f.allFinite()) f.setZero();
+    // A brake through a (nearly) singular H would be a force without bound.
+    if (!f.allFinite() ||
+        terms.H.norm() * f.norm() > kMaxLegJacobianCondition * (terms.H * f).norm()) {
+      f.setZero();
+    }
   }
   if (force_limits_) f = f.cwiseMax(-force_limit_n_).cwiseMin(force_limit_n_);
   return f;
@@ -305,7 +323,9 @@ bool SafetyFilter::ComputeMetricMap(const DynamicsTerms& terms, const BarrierInt
     map->setConstant(NAN);
     return false;
   }
-  return AccelerationMetricMap(terms.H, x.inertia, map);
+  if (AccelerationMetricMap(terms.H, x.inertia, map)) return true;
+  workspace_.leg_jacobian_degenerate = true;
+  return false;
 }
 
 void SafetyFilter::SolveUnlimited(const StepInput& in, const FilterWorkspace& ws,
@@ -349,7 +369,10 @@ void SafetyFilter::SolveUnlimited(const StepInput& in, const FilterWorkspace& ws
     // F* - F_des = W^-1 (mu_p g_p + mu_v g_v) with W^-1 = H^-1 M H^-T:
     // H (F* - F_des) = mu_v a_c - mu_p s_p M qd, one solve with H.
     Vector6d correction = s.mu_v * x.a_c - (s.mu_p * x.s_p) * x.m_qd;
-    if (!SolvePartialPivot6(in.terms.H, &correction)) correction.setConstant(NAN);  // fallback
+    if (!SolveWithLegJacobian(in.terms.H, &correction)) {
+      correction.setConstant(NAN);  // the fallback
+      workspace_.leg_jacobian_degenerate = true;
+    }
     d->f_safe = in.f_des + correction;
   }
 }

@@ -77,6 +77,44 @@ TEST(DegeneratePose, UpsideDownIsInvalidInputAtAndNearPi) {
   }
 }
 
+// psi = pi/2 at home height: every leg inside its stroke, H singular.
+TEST(DegeneratePose, SingularYawIsInvalidInput) {
+  const PlatformParams& p = DefaultConfig().platform;
+  for (const double psi : {kPi / 2, kPi / 2 - 1e-6, -kPi / 2, kMaxYawRad + 1e-9}) {
+    Vector6d q = DefaultConfig().home_pose;
+    q(5) = psi;
+    ASSERT_EQ(PoseProblems(p, q, InverseKinematics(p, q)), kPoseYawBeyondBound);
+    for (const Variant& v : kVariants) {
+      SafetyFilter filter = MakeRichFilter(v.force_limits, v.variant);
+      ExpectRejected(&filter, q, v.Name() + " psi = " + std::to_string(psi));
+    }
+  }
+}
+
+// A singular H at a pose inside every bound (the terms given to
+// StepWithTerms): the solves with H detect it (kMaxLegJacobianCondition),
+// invalid input and zero force, wherever the step needs H.
+TEST(DegeneratePose, SingularLegJacobianIsInvalidInputWhereTheStepSolvesWithIt) {
+  const Vector6d q = DefaultConfig().home_pose;
+  const Vector6d qd = Vector6d::Constant(0.001);
+  DynamicsTerms t = EvaluateDynamics(DefaultConfig().platform, q, qd);
+  const Vector6d f_des = InverseDynamics(t, Vector6d::Unit(0) * 20.0);  // the filter must act
+  t.H.col(5) = t.H.col(4) * (1.0 + 1e-12);  // two legs along one line of force
+  for (const Variant& v : kVariants) {
+    SafetyConfig config = RichSafetyConfig();
+    config.variant = v.variant;
+    config.force_limits_enabled = v.force_limits;
+    config.correction_metric = CorrectionMetric::kAcceleration;
+    SafetyFilter filter(DefaultConfig().platform, config, DefaultConfig().actuators);
+    SafetyDiagnostics d;
+    const Vector6d f = filter.StepWithTerms(t, q, qd, f_des, &d);
+    EXPECT_EQ(f, Vector6d::Zero()) << v.Name() << "\nF* " << f.transpose();
+    EXPECT_TRUE(d.flags & kFlagInvalidInput) << v.Name();
+    EXPECT_TRUE(d.flags & kFlagFallback) << v.Name();
+    EXPECT_FALSE(d.flags & kFlagInfeasible) << v.Name();
+  }
+}
+
 TEST(DegeneratePose, BelowTheBaseIsInvalidInput) {
   // Mirrored through the base plane every leg has its home length: only
   // z <= 0 tells this pose from home.

@@ -16,9 +16,11 @@ namespace stewart::safety {
 /// is singular at |theta| = pi/2, and with it H = J_l^T; the model's own
 /// workspace (PoseInWorkspace) stops at the same 1 rad.
 constexpr double kMaxTiltRad = 1.0;
-/// |psi| above this (rad) is rejected: yaw is a principal angle; 1e300 rad
-/// is a finite number whose sine is not an orientation anyone estimated.
-constexpr double kMaxYawRad = 3.141592653589793;
+/// |psi| above this (rad) is rejected: 1e300 rad is a finite number whose
+/// sine is not an orientation anyone estimated, and at psi = +-pi/2 the legs
+/// are in a singular configuration (H singular with every leg inside its
+/// stroke: cond(H) 1e17 at home height).
+constexpr double kMaxYawRad = 1.0;
 /// A leg may read this far beyond either stroke end (m) before the pose is
 /// rejected: the estimator accepts leg readings that far out
 /// (estimator.leg_range_margin_m, 0.01 m shipped), so an estimate at an

@@ -26,6 +26,13 @@ namespace stewart::safety {
 /// |F_des_i| above this (N) is treated as invalid input, not filtered.
 constexpr double kMaxInputForceN = 1e7;
 
+/// A solve with H = J_l^T that amplifies its right-hand side by more than
+/// this (||H|| ||X|| > 1e8 ||B||, a lower bound of cond(H)) meets a singular
+/// configuration of the legs (theta = pi, psi = +-pi/2 at home: docs/safety.md
+/// "Implausible poses"): invalid input, zero force, never a force 1e8 times
+/// its cause.
+constexpr double kMaxLegJacobianCondition = 1e8;
+
 /// Variant qp: a reference correction ||F* - F_nom|| at or below this
 /// fraction of max(||F_nom||, 1 N) is the solver's rounding, not an
 /// intervention: F* = F_nom, not flagged active (docs/safety.md, "QP
