@@ -156,8 +156,9 @@ void SafetyFilter::SolveUncomposed(const StepInput& in, FilterWorkspace* ws,
       y = r.x;
       velocity_share = 0.0;
       if (velocity_ok) {
-        velocity_share = StepKeepingRows(qp, r.x, velocity.result.x - r.x);
-        y += velocity_share * (velocity.result.x - r.x);
+        const Vector6d dy = velocity.result.x - r.x;
+        velocity_share = StepKeepingRows(qp, r.x, dy);
+        y += velocity_share * dy;
       }
     }
   }
