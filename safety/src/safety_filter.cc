@@ -240,7 +240,7 @@ Vector6d SafetyFilter::StepWithTerms(const DynamicsTerms& terms, const Vector6d&
     d->filter_case = FilterCase::kFallback;
     d->flags |= kFlagFallback | (valid ? kFlagInfeasible : kFlagInvalidInput);
     d->infeasible = valid;
-    d->f_safe = SafeStop(terms, qd, state_valid && valid, held_disturbance);
+    d->f_safe = SafeStop(terms, qd, state_valid && !ws.leg_jacobian_degenerate, held_disturbance);
   }
   FinishStep(f_des, d);
   return d->f_safe;
