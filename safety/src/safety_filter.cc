@@ -8,6 +8,7 @@
 #include "stewart/common/check.h"
 #include "stewart/model/linear_algebra6.h"
 #include "stewart/safety/nominal_bound.h"
+#include "stewart/safety/pose_plausibility.h"
 
 namespace stewart::safety {
 namespace {
@@ -45,10 +46,20 @@ TwoConstraintProblem MakeProblem(const ConstraintSet& c, const BarrierEvaluation
   return p;
 }
 
+// Solves H X = B in place; false when H is singular or so nearly singular
+// that the solve amplifies B by more than kMaxLegJacobianCondition
+// (||H|| ||X|| / ||B|| <= cond(H)). Costs two norms on the steps that solve.
+template <int Cols>
+bool SolveWithLegJacobian(const Matrix6d& h, Eigen::Matrix<double, 6, Cols>* b) {
+  const double rhs_norm = b->norm();
+  if (!SolvePartialPivot6(h, b)) return false;
+  return h.norm() * b->norm() <= kMaxLegJacobianCondition * rhs_norm;
+}
+
 // T = H^-1 L_M given the factor of M; false (T NaN) when H is singular.
 bool AccelerationMetricMap(const Matrix6d& h, const Cholesky6& inertia, Matrix6d* map) {
   *map = inertia.MatrixL();
-  if (SolvePartialPivot6(h, map)) return true;
+  if (SolveWithLegJacobian(h, map)) return true;
   map->setConstant(NAN);
   return false;
 }
@@ -143,8 +154,12 @@ Vector6d SafetyFilter::StepWithTerms(const DynamicsTerms& terms, const Vector6d&
   d->mu_force.setZero();
   d->f_des = f_des;
   d->compute_ns = 0;
+  workspace_.leg_jacobian_degenerate = false;
 
-  const bool state_valid = StateAndTermsFinite(q, qd, terms);
+  // A finite pose the platform cannot be in (pose_plausibility.h) is as
+  // invalid as a NaN: its model terms are numbers without meaning.
+  const bool state_valid = StateAndTermsFinite(q, qd, terms) &&
+                           PoseProblems(platform_, q, terms.leg_length_m) == kPosePlausible;
   // NaN compares false: this also rejects non-finite entries.
   // A non-finite disturbance estimate is an invalid state, like a NaN in q.
   const bool disturbance_valid =
@@ -219,10 +234,13 @@ Vector6d SafetyFilter::StepWithTerms(const DynamicsTerms& terms, const Vector6d&
     d->mu_position.fill(0.0);
     d->mu_velocity.fill(0.0);
     d->mu_force.setZero();
+    // A singular configuration (H) is an implausible pose: invalid input,
+    // and no hold brake, which would solve with that H.
+    const bool valid = input_valid && !ws.leg_jacobian_degenerate;
     d->filter_case = FilterCase::kFallback;
-    d->flags |= kFlagFallback | (input_valid ? kFlagInfeasible : kFlagInvalidInput);
-    d->infeasible = input_valid;
-    d->f_safe = SafeStop(terms, qd, state_valid, held_disturbance);
+    d->flags |= kFlagFallback | (valid ? kFlagInfeasible : kFlagInvalidInput);
+    d->infeasible = valid;
+    d->f_safe = SafeStop(terms, qd, state_valid && !ws.leg_jacobian_degenerate, held_disturbance);
   }
   FinishStep(f_des, d);
   return d->f_safe;
@@ -251,13 +269,16 @@ Vector6d SafetyFilter::SafeStopCommand(const Vector6d& q, const Vector6d& qd,
   *d = SafetyDiagnostics{};
   d->variant = variant_;
   DynamicsTerms& terms = workspace_.terms;
-  const bool state_valid = q.allFinite() && qd.allFinite();
-  if (state_valid) EvaluateDynamics(platform_, q, qd, &terms);
+  bool state_valid = q.allFinite() && qd.allFinite();
+  if (state_valid) {
+    EvaluateDynamics(platform_, q, qd, &terms);
+    state_valid =
+        terms.M.allFinite() && PoseProblems(platform_, q, terms.leg_length_m) == kPosePlausible;
+  }
   d->filter_case = FilterCase::kFallback;
   d->flags = kFlagFallback;
   const bool use_d = use_disturbance_ && disturbance.force_n.allFinite();
-  d->f_safe = SafeStop(terms, qd, state_valid && terms.M.allFinite(),
-                       use_d ? disturbance.force_n : kNoDisturbance);
+  d->f_safe = SafeStop(terms, qd, state_valid, use_d ? disturbance.force_n : kNoDisturbance);
   return d->f_safe;
 }
 
@@ -268,7 +289,11 @@ Vector6d SafetyFilter::SafeStop(const DynamicsTerms& terms, const Vector6d& qd, 
     // Gravity-compensating brake: qdd = -qd / stop_time_s, against the
     // estimated model error too (a payload would otherwise sink).
     f = InverseDynamics(terms, -qd / stop_time_s_, disturbance_n);
-    if (!f.allFinite()) f.setZero();
+    // A brake through a (nearly) singular H would be a force without bound.
+    if (!f.allFinite() ||
+        terms.H.norm() * f.norm() > kMaxLegJacobianCondition * (terms.H * f).norm()) {
+      f.setZero();
+    }
   }
   if (force_limits_) f = f.cwiseMax(-force_limit_n_).cwiseMin(force_limit_n_);
   return f;
@@ -298,7 +323,9 @@ bool SafetyFilter::ComputeMetricMap(const DynamicsTerms& terms, const BarrierInt
     map->setConstant(NAN);
     return false;
   }
-  return AccelerationMetricMap(terms.H, x.inertia, map);
+  if (AccelerationMetricMap(terms.H, x.inertia, map)) return true;
+  workspace_.leg_jacobian_degenerate = true;
+  return false;
 }
 
 void SafetyFilter::SolveUnlimited(const StepInput& in, const FilterWorkspace& ws,
@@ -342,7 +369,10 @@ void SafetyFilter::SolveUnlimited(const StepInput& in, const FilterWorkspace& ws
     // F* - F_des = W^-1 (mu_p g_p + mu_v g_v) with W^-1 = H^-1 M H^-T:
     // H (F* - F_des) = mu_v a_c - mu_p s_p M qd, one solve with H.
     Vector6d correction = s.mu_v * x.a_c - (s.mu_p * x.s_p) * x.m_qd;
-    if (!SolvePartialPivot6(in.terms.H, &correction)) correction.setConstant(NAN);  // fallback
+    if (!SolveWithLegJacobian(in.terms.H, &correction)) {
+      correction.setConstant(NAN);  // the fallback
+      workspace_.leg_jacobian_degenerate = true;
+    }
     d->f_safe = in.f_des + correction;
   }
 }
@@ -447,7 +477,21 @@ void SafetyFilter::SolveReference(const StepInput& in, FilterWorkspace* ws,
   const Eigen::Vector2d mu = g.colPivHouseholderQr().solve(y - qp.x0);
   d->mu_p = mu.allFinite() ? std::fmax(mu(0), 0.0) : 0.0;
   d->mu_v = mu.allFinite() ? std::fmax(mu(1), 0.0) : 0.0;
+  // A condition whose share of the correction is of rounding size (the least
+  // squares recovers ~1e-16 for a row the solver left inactive) is not
+  // active: the same tolerance as the flag, in the metric's coordinates.
+  const double rounding = kReferenceActiveRelTol * std::fmax(qp.x0.norm(), 1.0);
+  if (d->mu_p * problem.g_p.norm() <= rounding) d->mu_p = 0.0;
+  if (d->mu_v * problem.g_v.norm() <= rounding) d->mu_v = 0.0;
   d->f_safe = ForceFromQpSolution(ws->metric_map, y);
+  // The solver's tolerances and the round trip F = T (T^-1 F_nom) leave a
+  // correction of rounding size on states no condition cuts: that is F_nom
+  // itself, not an intervention (flag "active", docs/safety.md "QP reference").
+  const Vector6d correction = d->f_safe - in.f_des;
+  if (correction.norm() <= kReferenceActiveRelTol * std::fmax(in.f_des.norm(), 1.0)) {
+    d->f_safe = in.f_des;
+    d->mu_p = d->mu_v = 0.0;
+  }
   ReportQpSolution(nullptr, d);  // the reference solver gives no row multipliers
 }
 

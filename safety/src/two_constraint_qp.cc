@@ -81,7 +81,8 @@ TwoConstraintSolution SolveExactKkt(const TwoConstraintGram& pr) {
   // Case 4: both active; needs linearly independent normals.
   if (!g.p_zero && !g.v_zero) {
     const double det = g.pp * g.vv - g.pv * g.pv;
-    if (det > kParallelSin2 * g.pp * g.vv) {
+    const double parallel_sin2 = g.pv < 0.0 ? kOpposingParallelSin2 : kParallelSin2;
+    if (det > parallel_sin2 * g.pp * g.vv) {
       const double mu_p = (-psi_p * g.vv + psi_v * g.pv) / det;
       const double mu_v = (-psi_v * g.pp + psi_p * g.pv) / det;
       const double scale_p = (std::fabs(psi_p * g.vv) + std::fabs(psi_v * g.pv)) / det;
@@ -92,7 +93,8 @@ TwoConstraintSolution SolveExactKkt(const TwoConstraintGram& pr) {
     }
   }
   // Case 5: a violated condition with a zero normal, or (anti)parallel
-  // normals with an empty slab.
+  // normals with an empty slab (opposing normals within kOpposingParallelSin2
+  // count as anti-parallel).
   return Make(0, 0, FilterCase::kInfeasible, false);
 }
 

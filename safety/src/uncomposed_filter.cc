@@ -137,16 +137,13 @@ void SafetyFilter::SolveUncomposed(const StepInput& in, FilterWorkspace* ws,
       // As the closed form's fallback (SolveInfeasibleFallback), per row:
       // meet the position rows with the least correction, then move toward
       // the velocity rows' projection only as far as the position rows
-      // allow; when no force can meet the position rows (at rest outside the
-      // set), the velocity rows alone.
-      const bool keep_position =
-          SolvePosed(PoseUncomposedQp(in, ConditionGroups::kPositionOnly, *ws, &main), &main);
-      if (!keep_position) {
-        r.status = ProjectionStatus::kOptimal;  // nothing to meet: y0 itself
-        r.iterations = 0;
-        r.mu.setZero();
-        r.x = qp.x0;
-        main.rows.position_row.fill(-1);
+      // allow. When no force can meet the position rows (a violated row
+      // with a zero normal: at rest within a position margin), the
+      // documented safe stop, flagged as the force-limited case above
+      // (docs/safety.md, "Infeasibility fallback").
+      if (!SolvePosed(PoseUncomposedQp(in, ConditionGroups::kPositionOnly, *ws, &main), &main)) {
+        ApplySafeStop(in, d);
+        return;
       }
       velocity.result.status = ProjectionStatus::kInfeasible;
       if (PoseUncomposedQp(in, ConditionGroups::kVelocityOnly, *ws, &velocity)) {
@@ -155,16 +152,12 @@ void SafetyFilter::SolveUncomposed(const StepInput& in, FilterWorkspace* ws,
       }
       const bool velocity_ok = velocity.result.status == ProjectionStatus::kOptimal;
       if (!velocity_ok) velocity.result.mu.setZero();
-      if (!keep_position && !velocity_ok) {
-        ApplySafeStop(in, d);
-        return;
-      }
       split = true;
       y = r.x;
       velocity_share = 0.0;
       if (velocity_ok) {
         const Vector6d dy = velocity.result.x - r.x;
-        velocity_share = keep_position ? StepKeepingRows(qp, r.x, dy) : 1.0;
+        velocity_share = StepKeepingRows(qp, r.x, dy);
         y += velocity_share * dy;
       }
     }

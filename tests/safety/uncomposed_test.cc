@@ -7,6 +7,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <string>
 
 #include "stewart/model/kinematics.h"
 #include "uncomposed_support.h"
@@ -332,6 +333,47 @@ TEST(UncomposedDegenerate, EmptyVelocitySlabKeepsThePositionRows) {
       const size_t k = static_cast<size_t>(i);
       EXPECT_GE(at_f.psi_position[k], -1e-10 * (1e-3 + at_f.n_position[k].norm() * scale))
           << "sample " << n;
+    }
+  }
+}
+
+// A violated position row with a zero normal (at rest, 10 mm beyond x <=
+// 0.11, no recovery barriers to leave the position group out): no force can
+// meet it. The answer is the documented safe stop, flagged infeasible and
+// fallback, as the closed form's last resort and the force-limited variant
+// (before, the unlimited variant applied the velocity rows alone, flagged
+// only infeasible).
+TEST(UncomposedDegenerate, PositionRowsNoForceCanMeetGiveTheFlaggedSafeStop) {
+  SafetyConfig config = RichSafetyConfig();
+  config.variant = SafetyVariant::kUncomposed;
+  config.recovery_gain_per_s = 0.0;
+  Vector6d q = DefaultConfig().home_pose;
+  q(0) = 0.12;
+  const Vector6d qd = Vector6d::Zero();
+  const DynamicsTerms t = EvaluateDynamics(DefaultConfig().platform, q, qd);
+  for (const bool force_limits : {false, true}) {
+    config.force_limits_enabled = force_limits;
+    SafetyFilter filter(DefaultConfig().platform, config, DefaultConfig().actuators);
+    for (const Vector6d& f_des :
+         {HoverForce(q), Vector6d(InverseDynamics(t, Vector6d::Unit(0) * 5.0))}) {
+      SafetyDiagnostics d;
+      const Vector6d f = filter.Step(q, qd, f_des, &d);
+      const std::string where = force_limits ? "force-limited" : "unlimited";
+      EXPECT_FALSE(d.barriers.outside_position_set) << where;
+      EXPECT_TRUE(d.infeasible) << where;
+      EXPECT_EQ(d.filter_case, FilterCase::kFallback) << where;
+      EXPECT_TRUE(d.flags & kFlagFallback) << where;
+      EXPECT_TRUE(d.flags & kFlagInfeasible) << where;
+      EXPECT_FALSE(d.flags & kFlagInvalidInput) << where;
+      EXPECT_EQ(d.mu_p, 0.0) << where;
+      EXPECT_EQ(d.mu_v, 0.0) << where;
+      SafetyDiagnostics stop;
+      EXPECT_EQ(f, filter.SafeStopCommand(q, qd, &stop)) << where;
+      // The same command as the closed form's safe stop at this state.
+      SafetyConfig closed = config;
+      closed.variant = SafetyVariant::kClosedForm;
+      SafetyFilter closed_form(DefaultConfig().platform, closed, DefaultConfig().actuators);
+      EXPECT_EQ(f, closed_form.SafeStopCommand(q, qd, &stop)) << where;
     }
   }
 }

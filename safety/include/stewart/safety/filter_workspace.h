@@ -38,13 +38,17 @@ using UncomposedQpData = PosedQp<kMaxUncomposedQpRows, UncomposedQpRows>;
 // On a cache line of its own, so that which lines a step touches does not
 // depend on where the filter holding it sits.
 struct alignas(64) FilterWorkspace {
-  DynamicsTerms terms;              ///< model terms at (q, qd), evaluated by Step
-  BarrierIntermediates barrier;     ///< what EvaluateBarriers leaves for the solve
-  Matrix6d metric_map;              ///< T (SafetyFilter::MetricMap), when a QP is posed
-  TwoConstraintProblem problem;     ///< the composed conditions in y = T^-1 F
-  ComposedQpData composed;          ///< force-limited variant and QP reference
-  UncomposedQpData uncomposed;      ///< variant uncomposed: every row, or the position rows
-  UncomposedQpData velocity_alone;  ///< its unlimited fallback: the velocity rows alone
+  DynamicsTerms terms;           ///< model terms at (q, qd), evaluated by Step
+  BarrierIntermediates barrier;  ///< what EvaluateBarriers leaves for the solve
+  Matrix6d metric_map;           ///< T (SafetyFilter::MetricMap), when a QP is posed
+  TwoConstraintProblem problem;  ///< the composed conditions in y = T^-1 F
+  ComposedQpData composed;       ///< force-limited variant and QP reference
+  UncomposedQpData uncomposed;   ///< variant uncomposed: every row, or the position rows
+  UncomposedQpData
+      velocity_alone;  ///< its unlimited fallback: the velocity rows, from the position rows' point
+  /// A solve with H this step met H singular or nearly so
+  /// (kMaxLegJacobianCondition): the pose is a singular configuration.
+  bool leg_jacobian_degenerate = false;
 };
 
 }  // namespace stewart::safety

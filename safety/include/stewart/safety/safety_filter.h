@@ -26,6 +26,20 @@ namespace stewart::safety {
 /// |F_des_i| above this (N) is treated as invalid input, not filtered.
 constexpr double kMaxInputForceN = 1e7;
 
+/// A solve with H = J_l^T that amplifies its right-hand side by more than
+/// this (||H|| ||X|| > 1e8 ||B||, a lower bound of cond(H)) meets a singular
+/// configuration of the legs (theta = pi, psi = +-pi/2 at home: docs/safety.md
+/// "Implausible poses"): invalid input, zero force, never a force 1e8 times
+/// its cause.
+constexpr double kMaxLegJacobianCondition = 1e8;
+
+/// Variant qp: a reference correction ||F* - F_nom|| at or below this
+/// fraction of max(||F_nom||, 1 N) is the solver's rounding, not an
+/// intervention: F* = F_nom, not flagged active (docs/safety.md, "QP
+/// reference"). Ten times below the references' stated agreement with the
+/// closed form (1e-9), far above what rounding leaves.
+constexpr double kReferenceActiveRelTol = 1e-10;
+
 class SafetyFilter {
  public:
   /// Throws InputError (a std::invalid_argument naming the config key) for an
@@ -56,7 +70,8 @@ class SafetyFilter {
 
   /// The configured safe stop at (q, qd), for when no usable nominal command
   /// exists (stale or missing): flagged kFlagFallback, case kFallback. Zero
-  /// force if the state itself is not finite.
+  /// force if the state is not finite or its pose not plausible
+  /// (pose_plausibility.h).
   Vector6d SafeStopCommand(const Vector6d& q, const Vector6d& qd, SafetyDiagnostics* diagnostics);
   /// The same, holding against the estimated model error d too (ignored
   /// when not finite or when safety.use_disturbance_estimate is false).

@@ -66,6 +66,19 @@ struct TwoConstraintSolution {
 /// angle between the normals) counts as parallel normals.
 constexpr double kParallelSin2 = 1e-12;
 
+/// Opposing normals (g_p.g_v < 0) count as anti-parallel below this sin^2,
+/// a wider band than kParallelSin2. Both conditions active with opposing
+/// normals at angle pi - a meet only at the far tip of a wedge: the exact
+/// correction is up to sqrt(2) (|psi_p|/|g_p| + |psi_v|/|g_v|) / sin a, 1e6 times
+/// either condition's own correction at sin^2 = 1e-12 (measured: 6.6e6 N on
+/// the filter). Below this threshold case 4 is not taken: the slab is
+/// treated as empty (case 5, the flagged infeasibility fallback), which
+/// bounds every correction the case analysis returns by 1415 times the
+/// conditions' own (docs/safety.md, "Exact case analysis"). Same-direction
+/// normals keep kParallelSin2: their case-4 correction stays within the
+/// conditions' own whatever the angle.
+constexpr double kOpposingParallelSin2 = 1e-6;
+
 /// Exact KKT case analysis (cases 1-5 of NOTES.md).
 TwoConstraintSolution SolveExactKkt(const TwoConstraintProblem& problem);
 TwoConstraintSolution SolveExactKkt(const TwoConstraintGram& gram);
