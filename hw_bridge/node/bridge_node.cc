@@ -108,8 +108,9 @@ void BridgeNode::OnFrame(const hw::DecodedFrame& frame) {
     if (bridge_.device_session() == bridge_.link_session()) {
       spdlog::info("hw_bridge: the device follows link session {}", bridge_.link_session());
     } else {
-      spdlog::warn("hw_bridge: the device follows link session {}, not this bridge's {}: zero drive",
-                   bridge_.device_session(), bridge_.link_session());
+      spdlog::warn(
+          "hw_bridge: the device follows link session {}, not this bridge's {}: zero drive",
+          bridge_.device_session(), bridge_.link_session());
     }
   }
   if (outcome == hw::FrameOutcome::kUnexpectedType) {

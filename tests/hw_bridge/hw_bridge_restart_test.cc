@@ -138,8 +138,8 @@ TEST_F(HwBridgeRestart, TheDeviceFollowsARestartedBridgeAndTheLimitsHold) {
   // Armed and cruising towards x = 0.1 m.
   ASSERT_TRUE(pump_until(
       [&] {
-        return bus.have_supervisor &&
-               bus.supervisor.state == supervisor_state_t::STATE_ARMED && bus.truth.q[0] > 0.02;
+        return bus.have_supervisor && bus.supervisor.state == supervisor_state_t::STATE_ARMED &&
+               bus.truth.q[0] > 0.02;
       },
       30.0))
       << "the platform did not start moving: supervisor state " << int{bus.supervisor.state}
@@ -169,8 +169,8 @@ TEST_F(HwBridgeRestart, TheDeviceFollowsARestartedBridgeAndTheLimitsHold) {
       pump_until([&] { return watchdog_clear(old_samples) != 0; }, 3.0 + kCommandedBoundS);
   ASSERT_GT(bus.sensors.size(), old_samples) << "the new bridge published no sample";
   const sensor_t& first_new = bus.sensors[old_samples];
-  const std::size_t watchdog_samples = (left ? watchdog_clear(old_samples) : bus.sensors.size()) -
-                                       old_samples;
+  const std::size_t watchdog_samples =
+      (left ? watchdog_clear(old_samples) : bus.sensors.size()) - old_samples;
   ASSERT_TRUE(left) << "the device reported WATCHDOG on all " << bus.sensors.size() - old_samples
                     << " samples after the restart (first status " << first_new.status << ")";
   const double leave_ms =
@@ -205,8 +205,8 @@ TEST_F(HwBridgeRestart, TheDeviceFollowsARestartedBridgeAndTheLimitsHold) {
     const CtlResult resume = Ctl("resume " + ctl_common);
     EXPECT_EQ(resume.exit_code, 0) << resume.out;
   }
-  ASSERT_TRUE(pump_until(
-      [&] { return bus.supervisor.state == supervisor_state_t::STATE_ARMED; }, 5.0))
+  ASSERT_TRUE(
+      pump_until([&] { return bus.supervisor.state == supervisor_state_t::STATE_ARMED; }, 5.0))
       << "not armed again: " << bus.supervisor.reason;
   const double x_resumed = bus.truth.q[0];
   ASSERT_TRUE(pump_until([&] { return bus.truth.q[0] > x_resumed + 0.01; }, 5.0))
@@ -217,11 +217,13 @@ TEST_F(HwBridgeRestart, TheDeviceFollowsARestartedBridgeAndTheLimitsHold) {
       "restart; supervisor %s after the restart%s; x %.4f -> %.4f m after the resume\n",
       x_at_kill, leave_ms, watchdog_samples, commanded_s,
       state_after_restart == supervisor_state_t::STATE_HOLD ? "HOLD" : "not HOLD",
-      state_after_restart == supervisor_state_t::STATE_HOLD ? " (reset, resume by stewart_ctl)" : "",
+      state_after_restart == supervisor_state_t::STATE_HOLD ? " (reset, resume by stewart_ctl)"
+                                                            : "",
       x_resumed, bus.truth.q[0]);
-  std::printf("[hw_bridge restart] new bridge: device_rx_session_rejected %ld, device_rx_lost %ld\n",
-              static_cast<long>(Counter(h, "device_rx_session_rejected")),
-              static_cast<long>(Counter(h, "device_rx_lost")));
+  std::printf(
+      "[hw_bridge restart] new bridge: device_rx_session_rejected %ld, device_rx_lost %ld\n",
+      static_cast<long>(Counter(h, "device_rx_session_rejected")),
+      static_cast<long>(Counter(h, "device_rx_lost")));
 
   // (4) Every limit held on ground truth over the whole run.
   bridge->Stop(SIGTERM);

@@ -114,8 +114,7 @@ void EmulatorNode::OnFrame(const hw::DecodedFrame& frame, uint64_t rx_us) {
     if (verdict == hw::CommandAcceptance::kAdopted) {
       spdlog::info("hw_emulator: following link session {} from seq {} (was {})",
                    frame.command.session, frame.command.seq, was);
-    } else if (hw::IsSessionRejection(verdict) &&
-               frame.command.session != last_rejected_session_) {
+    } else if (hw::IsSessionRejection(verdict) && frame.command.session != last_rejected_session_) {
       last_rejected_session_ = frame.command.session;
       spdlog::warn("hw_emulator: command frames of link session {} rejected ({}; following {})",
                    frame.command.session, ToString(verdict), was);

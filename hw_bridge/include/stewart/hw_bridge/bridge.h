@@ -46,12 +46,12 @@ struct SensorSample {
 /// (bringup.h) "command" is the latest duty command, else the latest safe
 /// force command.
 enum class DriveReason {
-  kCommand,   ///< the latest command, mapped
-  kMissing,   ///< no valid command received yet: zero drive
-  kStale,     ///< the held command is older than command_timeout_s: zero drive
-  kInvalid,   ///< the latest command was non-finite: zero drive
-  kDriveOff,  ///< the latest safe command says FLAG_DRIVE_OFF: zero drive
-  kGuard,     ///< the last-line guard has tripped (latched): zero drive
+  kCommand,         ///< the latest command, mapped
+  kMissing,         ///< no valid command received yet: zero drive
+  kStale,           ///< the held command is older than command_timeout_s: zero drive
+  kInvalid,         ///< the latest command was non-finite: zero drive
+  kDriveOff,        ///< the latest safe command says FLAG_DRIVE_OFF: zero drive
+  kGuard,           ///< the last-line guard has tripped (latched): zero drive
   kSessionPending,  ///< the device does not (yet) follow this bridge's link session: zero drive
 };
 inline constexpr EnumTable<DriveReason, 7> kDriveReasonNames{{{
@@ -121,17 +121,17 @@ struct BridgeCounters {
   uint64_t force_deadzoned =
       0;                     ///< legs whose non-zero force fell in the dead zone (frames x legs)
   uint64_t guard_trips = 0;  ///< bring-up: legs the guard tripped (events)
-  uint64_t drive_off_frames = 0;   ///< frames sent with zero drive for the supervisor's drive off
-  uint64_t guard_frames = 0;       ///< frames sent with zero drive for the tripped last-line guard
-  uint64_t session_pending_frames = 0;  ///< frames sent with zero drive before the device's echo
+  uint64_t drive_off_frames = 0;  ///< frames sent with zero drive for the supervisor's drive off
+  uint64_t guard_frames = 0;      ///< frames sent with zero drive for the tripped last-line guard
+  uint64_t session_pending_frames = 0;   ///< frames sent with zero drive before the device's echo
   uint64_t session_pending_samples = 0;  ///< samples whose echoed session was not this bridge's
-  int64_t applied_age_max_us = 0;  ///< oldest command whose force went out (sample age, us)
+  int64_t applied_age_max_us = 0;        ///< oldest command whose force went out (sample age, us)
   uint64_t guard_limited_frames = 0;  ///< bring-up: frames in which the guard zeroed a leg's duty
   uint64_t device_rx_corrupt = 0;     ///< the device's own counters (latest)
   uint64_t device_rx_lost = 0;
   uint64_t device_rx_session_rejected = 0;  ///< frames of a session the device did not adopt
-  WindowStats rtt_us;    ///< command round trip, per health window
-  WindowStats delay_us;  ///< host arrival - sample utime, per health window
+  WindowStats rtt_us;                       ///< command round trip, per health window
+  WindowStats delay_us;                     ///< host arrival - sample utime, per health window
 };
 
 class HwBridge {

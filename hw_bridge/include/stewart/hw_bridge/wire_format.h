@@ -61,8 +61,8 @@ struct SensorFrame {
   std::array<int16_t, 6> applied_drive{};  ///< drive actually applied (after watchdog)
   uint32_t rx_corrupt = 0;                 ///< command frames the device rejected (total)
   uint32_t rx_lost = 0;                    ///< command seq gaps seen by the device (total)
-  uint32_t command_session = 0;  ///< link session the device follows (0: none yet)
-  uint32_t rx_session_rejected = 0;  ///< command frames of a session not adopted (total)
+  uint32_t command_session = 0;            ///< link session the device follows (0: none yet)
+  uint32_t rx_session_rejected = 0;        ///< command frames of a session not adopted (total)
 };
 
 /// Host -> device.

@@ -15,12 +15,12 @@
 namespace stewart::hw {
 
 enum class CommandAcceptance {
-  kApplied,          ///< the session's next frame: in force from its arrival
-  kAdopted,          ///< a new session starts with this frame; its seq check restarts here
-  kNotNewer,         ///< the session's duplicate or reordered frame: dropped
-  kRetiredSession,   ///< a session the device followed before (an old bridge's late frame)
-  kSessionLive,      ///< another session while the current one still drives the legs
-  kNeedsNoMotion,    ///< a new session's frame that asks for motion
+  kApplied,         ///< the session's next frame: in force from its arrival
+  kAdopted,         ///< a new session starts with this frame; its seq check restarts here
+  kNotNewer,        ///< the session's duplicate or reordered frame: dropped
+  kRetiredSession,  ///< a session the device followed before (an old bridge's late frame)
+  kSessionLive,     ///< another session while the current one still drives the legs
+  kNeedsNoMotion,   ///< a new session's frame that asks for motion
 };
 inline constexpr EnumTable<CommandAcceptance, 6> kCommandAcceptanceNames{{{
     {CommandAcceptance::kApplied, "applied"},
