@@ -80,7 +80,9 @@ bool HwBridge::OnSensorFrame(const SensorFrame& frame, int64_t host_rx_us, Senso
   if (device_session_ != link_session_) ++counters_.session_pending_samples;
 
   int64_t rtt_us = 0;
-  if (rtt_.OnEcho(frame.last_command_seq, frame.command_age_us, host_rx_us, &rtt_us)) {
+  // A seq of another session's frame says nothing about this bridge's.
+  if (device_session_ == link_session_ &&
+      rtt_.OnEcho(frame.last_command_seq, frame.command_age_us, host_rx_us, &rtt_us)) {
     counters_.rtt_us.Add(rtt_us);
   }
 

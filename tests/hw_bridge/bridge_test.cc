@@ -198,6 +198,19 @@ TEST_F(BridgeTest, RoundTripExcludesTheDeviceHoldTime) {
   EXPECT_EQ(bridge_.counters().rtt_us.count, 1);
 }
 
+TEST_F(BridgeTest, AnotherSessionsSeqIsNoRoundTrip) {
+  Deliver(0);
+  const DecodedFrame f = Send();
+  // The device still follows the bridge before this one, whose frame had
+  // the same seq: not this bridge's round trip.
+  device_session_ = 99U;
+  Deliver(1, 100, f.command.seq, 400);
+  EXPECT_EQ(bridge_.counters().rtt_us.count, 0);
+  device_session_.reset();
+  Deliver(2, 100, f.command.seq, 400);
+  EXPECT_EQ(bridge_.counters().rtt_us.count, 1);
+}
+
 TEST_F(BridgeTest, ImplausibleAdcAndSaturatedImuAreFlagged) {
   SensorFrame f;
   f.seq = 0;
