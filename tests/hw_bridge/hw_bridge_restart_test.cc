@@ -168,7 +168,7 @@ TEST_F(HwBridgeRestart, TheDeviceFollowsARestartedBridgeAndTheLimitsHold) {
   const bool left =
       pump_until([&] { return watchdog_clear(old_samples) != 0; }, 3.0 + kCommandedBoundS);
   ASSERT_GT(bus.sensors.size(), old_samples) << "the new bridge published no sample";
-  const sensor_t& first_new = bus.sensors[old_samples];
+  const sensor_t first_new = bus.sensors[old_samples];  // a copy: the vector grows
   const std::size_t watchdog_samples =
       (left ? watchdog_clear(old_samples) : bus.sensors.size()) - old_samples;
   ASSERT_TRUE(left) << "the device reported WATCHDOG on all " << bus.sensors.size() - old_samples
@@ -192,7 +192,7 @@ TEST_F(HwBridgeRestart, TheDeviceFollowsARestartedBridgeAndTheLimitsHold) {
       << "'";
   const double commanded_s = std::chrono::duration<double>(commanded() - restarted).count();
   EXPECT_LE(commanded_s, kCommandedBoundS);
-  const health_t& h = bus.bridge_health.back().second;
+  const health_t h = bus.bridge_health.back().second;  // a copy: the vector grows
   EXPECT_EQ(Counter(h, "device_session"), Counter(h, "link_session"));
   EXPECT_NE(Counter(h, "link_session"), 0);
 
