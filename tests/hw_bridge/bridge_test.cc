@@ -130,6 +130,7 @@ TEST_F(BridgeTest, ForcesInTheDeadZoneAreCounted) {
   HwBridge bridge(hw_, 0.385, 0.2, 100.0);
   SensorFrame frame;
   frame.adc.fill(2000);
+  frame.command_session = bridge.link_session();  // the device follows this bridge
   SensorSample sample;
   ASSERT_TRUE(bridge.OnSensorFrame(frame, kHostEpoch, &sample));
   Vector6d force = Vector6d::Constant(2.0);
