@@ -6,9 +6,10 @@
 // "Sessions"): it leaves WATCHDOG within kLeaveWatchdogBoundMs of stack time
 // after the new bridge's first sample, and the new bridge forwards the safe
 // commands again (health zero_drive 0) within kCommandedBoundS of wall time
-// after its start. The supervisor goes to HOLD while the sensors are gone
-// (stale estimates, fallbacks); the test then resumes it as an operator
-// would, with stewart_ctl reset and resume, and the platform must move on.
+// after its start. The supervisor latches HOLD on the bridge's restart (its
+// heartbeat sequence starts over: "hw_bridge restarted"); the test then
+// resumes it as an operator would, with stewart_ctl reset and resume, and
+// the platform must move on.
 // Every limit must hold on the emulator's recorded ground truth, the kill
 // and the restart included.
 //
