@@ -52,6 +52,8 @@ BridgeNode::BridgeNode(const StackConfig& config, lcm::LCM* lcm, hw::Transport* 
       operator_check_(SecondsToMicros(config.supervisor.operator_time_window_s)),
       health_("hw_bridge", config.lcm.channels.health, config.lcm.health_rate_hz),
       reader_(transport->datagram()) {
+  spdlog::info("hw_bridge: link session {} (zero drive until the device follows it)",
+               bridge_.link_session());
   receiver_.Subscribe(config.lcm.channels.supervisor, &BridgeNode::OnSupervisor, this);
   receiver_.Subscribe(config.lcm.channels.operator_command, &BridgeNode::OnOperator, this);
   spdlog::info(
@@ -100,7 +102,17 @@ void BridgeNode::ReadDevice() {
 
 void BridgeNode::OnFrame(const hw::DecodedFrame& frame) {
   hw::SensorSample sample;
+  const uint32_t device_session_was = bridge_.device_session();
   const hw::FrameOutcome outcome = bridge_.OnFrame(frame, clock_.NowMicros(), &sample);
+  if (bridge_.device_session() != device_session_was) {
+    if (bridge_.device_session() == bridge_.link_session()) {
+      spdlog::info("hw_bridge: the device follows link session {}", bridge_.link_session());
+    } else {
+      spdlog::warn(
+          "hw_bridge: the device follows link session {}, not this bridge's {}: zero drive",
+          bridge_.device_session(), bridge_.link_session());
+    }
+  }
   if (outcome == hw::FrameOutcome::kUnexpectedType) {
     health_.Reject("unexpected_frame_type");
     return;
@@ -226,6 +238,12 @@ void BridgeNode::UpdateHealth() {
   health_.SetCounter("device_watchdog_samples", static_cast<int64_t>(c.device_watchdog_samples));
   health_.SetCounter("device_rx_corrupt", static_cast<int64_t>(c.device_rx_corrupt));
   health_.SetCounter("device_rx_lost", static_cast<int64_t>(c.device_rx_lost));
+  health_.SetCounter("device_rx_session_rejected",
+                     static_cast<int64_t>(c.device_rx_session_rejected));
+  health_.SetCounter("link_session", bridge_.link_session());
+  health_.SetCounter("device_session", bridge_.device_session());
+  health_.SetCounter("session_pending_frames", static_cast<int64_t>(c.session_pending_frames));
+  health_.SetCounter("session_pending_samples", static_cast<int64_t>(c.session_pending_samples));
   const SafeCommandAcceptor& acceptor = bridge_.acceptor();
   const ActuatorGuard& guard = bridge_.actuator_guard();
   health_.SetCounter("safety_session", acceptor.session_id());

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "stewart/guard/guard_limits.h"
+#include "stewart/hw_bridge/link_session.h"
 
 namespace stewart::hw {
 namespace {
@@ -24,7 +25,8 @@ HwBridge::HwBridge(const HwBridgeConfig& hw, double min_length_m, double stroke_
       acceptor_(AcceptorLimitsOf(guard, hw.command_timeout_s)),
       actuator_guard_(ActuatorGuardLimitsOf(guard, min_length_m, min_length_m + stroke_m)),
       bringup_(bringup),
-      guard_(bringup.guard) {}
+      guard_(bringup.guard),
+      link_session_(NewLinkSession()) {}
 
 bool HwBridge::OnSensorFrame(const SensorFrame& frame, int64_t host_rx_us, SensorSample* sample) {
   if (have_sample_) {
@@ -70,9 +72,17 @@ bool HwBridge::OnSensorFrame(const SensorFrame& frame, int64_t host_rx_us, Senso
   if ((frame.status & kStatusWatchdog) != 0) ++counters_.device_watchdog_samples;
   counters_.device_rx_corrupt = frame.rx_corrupt;
   counters_.device_rx_lost = frame.rx_lost;
+  counters_.device_rx_session_rejected = frame.rx_session_rejected;
+  // Drive goes out only while the device follows this bridge: at start-up
+  // until it adopts the session, after a device restart until it adopts it
+  // again (CurrentReason).
+  device_session_ = frame.command_session;
+  if (device_session_ != link_session_) ++counters_.session_pending_samples;
 
   int64_t rtt_us = 0;
-  if (rtt_.OnEcho(frame.last_command_seq, frame.command_age_us, host_rx_us, &rtt_us)) {
+  // A seq of another session's frame says nothing about this bridge's.
+  if (device_session_ == link_session_ &&
+      rtt_.OnEcho(frame.last_command_seq, frame.command_age_us, host_rx_us, &rtt_us)) {
     counters_.rtt_us.Add(rtt_us);
   }
 
@@ -192,6 +202,10 @@ CommandVerdict HwBridge::OnDutyCommand(int64_t utime, const Vector6d& duty) {
 
 DriveReason HwBridge::CurrentReason() const {
   if (!bringup_.enabled && actuator_guard_.tripped()) return DriveReason::kGuard;
+  // Before the device follows this bridge, a frame with drive would be
+  // refused (it adopts a session only at rest) or, worse, be the first
+  // word of a link whose other end is not known.
+  if (device_session_ != link_session_) return DriveReason::kSessionPending;
   if (command_invalid_) return DriveReason::kInvalid;
   if (!have_command_) return DriveReason::kMissing;
   // Age in stack time: how far the device's samples have moved on since the
@@ -207,6 +221,7 @@ std::size_t HwBridge::BuildCommandFrame(int64_t host_now_us, uint8_t* out) {
   frame.seq = next_command_seq_++;
   frame.watchdog_us = static_cast<uint32_t>(std::lround(hw_.device_watchdog_s * 1e6));
   frame.flags = kCommandEnable;
+  frame.session = link_session_;
   last_reason_ = CurrentReason();
   if (last_reason_ == DriveReason::kCommand && bringup_.enabled) {
     // The duty as commanded, after the guard on the latest readings.
@@ -233,6 +248,7 @@ std::size_t HwBridge::BuildCommandFrame(int64_t host_now_us, uint8_t* out) {
     ++counters_.zero_drive_frames;
     if (last_reason_ == DriveReason::kDriveOff) ++counters_.drive_off_frames;
     if (last_reason_ == DriveReason::kGuard) ++counters_.guard_frames;
+    if (last_reason_ == DriveReason::kSessionPending) ++counters_.session_pending_frames;
   }
   ++counters_.command_frames;
   sent_watchdog_us_ = frame.watchdog_us;
@@ -260,6 +276,12 @@ LinkHealth HwBridge::Health(int64_t host_now_us, const std::string& link_descrip
     return {LinkState::kFault, "guard tripped: " + actuator_guard_.Describe() +
                                    "; zero drive (lead screws hold) until an operator RESET "
                                    "with the readings back inside"};
+  }
+  if (last_reason_ == DriveReason::kSessionPending) {
+    return {LinkState::kDegraded,
+            "zero drive: the device follows link session " + std::to_string(device_session_) +
+                ", not this bridge's " + std::to_string(link_session_) +
+                " (it adopts a new session only at rest, when no other bridge drives it)"};
   }
   if (last_reason_ != DriveReason::kCommand) {
     return {LinkState::kDegraded,

@@ -97,6 +97,8 @@ std::size_t EncodeSensorFrame(const SensorFrame& f, uint8_t* out) {
   for (int16_t v : f.applied_drive) w.I16(v);
   w.U32(f.rx_corrupt);
   w.U32(f.rx_lost);
+  w.U32(f.command_session);
+  w.U32(f.rx_session_rejected);
   return Finish(out, &w);
 }
 
@@ -107,6 +109,7 @@ std::size_t EncodeCommandFrame(const CommandFrame& f, uint8_t* out) {
   for (int16_t v : f.drive) w.I16(v);
   w.U16(f.flags);
   w.U16(0);  // reserved
+  w.U32(f.session);
   return Finish(out, &w);
 }
 
@@ -143,20 +146,30 @@ DecodeStatus DecodeFrame(const uint8_t* data, std::size_t size, DecodedFrame* ou
     for (int16_t& v : f.applied_drive) v = r.I16();
     f.rx_corrupt = r.U32();
     f.rx_lost = r.U32();
+    f.command_session = r.U32();
+    f.rx_session_rejected = r.U32();
   } else {
     CommandFrame& f = out->command;
     f.seq = seq;
     f.watchdog_us = r.U32();
     for (int16_t& v : f.drive) v = r.I16();
     f.flags = r.U16();
+    r.U16();  // reserved
+    f.session = r.U32();
     const bool drive_ok = std::none_of(f.drive.begin(), f.drive.end(),
                                        [](int16_t d) { return d < -kDriveFullScale; });
-    if (!drive_ok || f.watchdog_us < kMinWatchdogUs || f.watchdog_us > kMaxWatchdogUs) {
+    if (!drive_ok || f.watchdog_us < kMinWatchdogUs || f.watchdog_us > kMaxWatchdogUs ||
+        f.session == 0) {
       return DecodeStatus::kBadField;
     }
   }
   *consumed = total;
   return DecodeStatus::kOk;
+}
+
+bool AsksForNoMotion(const CommandFrame& frame) {
+  return (frame.flags & kCommandEnable) == 0 ||
+         std::all_of(frame.drive.begin(), frame.drive.end(), [](int16_t d) { return d == 0; });
 }
 
 DecodeStatus DecodeDatagram(const uint8_t* data, std::size_t size, DecodedFrame* out) {

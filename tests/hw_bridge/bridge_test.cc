@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <optional>
+
 #include "test_config.h"
 
 namespace stewart::hw {
@@ -43,6 +45,8 @@ class BridgeTest : public ::testing::Test {
     f.accel_raw = {0, 0, 8192};
     f.last_command_seq = echo_seq;
     f.command_age_us = age_us;
+    // The device follows this bridge unless a test says otherwise.
+    f.command_session = device_session_.value_or(bridge_.link_session());
     host_now_ = kHostEpoch + 1000 * static_cast<int64_t>(k) + delay_us;
     return bridge_.OnSensorFrame(f, host_now_, &sample_);
   }
@@ -60,6 +64,7 @@ class BridgeTest : public ::testing::Test {
   HwBridge bridge_;
   SensorSample sample_;
   int64_t host_now_ = 0;
+  std::optional<uint32_t> device_session_;  // the session the device echoes; none: the bridge's
 };
 
 TEST_F(BridgeTest, SampleInSiUnitsOnTheHostTimeBase) {
@@ -125,6 +130,7 @@ TEST_F(BridgeTest, ForcesInTheDeadZoneAreCounted) {
   HwBridge bridge(hw_, 0.385, 0.2, 100.0);
   SensorFrame frame;
   frame.adc.fill(2000);
+  frame.command_session = bridge.link_session();  // the device follows this bridge
   SensorSample sample;
   ASSERT_TRUE(bridge.OnSensorFrame(frame, kHostEpoch, &sample));
   Vector6d force = Vector6d::Constant(2.0);
@@ -193,6 +199,19 @@ TEST_F(BridgeTest, RoundTripExcludesTheDeviceHoldTime) {
   EXPECT_EQ(bridge_.counters().rtt_us.count, 1);
 }
 
+TEST_F(BridgeTest, AnotherSessionsSeqIsNoRoundTrip) {
+  Deliver(0);
+  const DecodedFrame f = Send();
+  // The device still follows the bridge before this one, whose frame had
+  // the same seq: not this bridge's round trip.
+  device_session_ = 99U;
+  Deliver(1, 100, f.command.seq, 400);
+  EXPECT_EQ(bridge_.counters().rtt_us.count, 0);
+  device_session_.reset();
+  Deliver(2, 100, f.command.seq, 400);
+  EXPECT_EQ(bridge_.counters().rtt_us.count, 1);
+}
+
 TEST_F(BridgeTest, ImplausibleAdcAndSaturatedImuAreFlagged) {
   SensorFrame f;
   f.seq = 0;
@@ -255,6 +274,7 @@ TEST_F(BridgeTest, HealthReportsTheWorstConditionFirst) {
   f.device_time_us = 1000;
   f.adc.fill(2000);
   f.status = kStatusSupplyLow;
+  f.command_session = bridge_.link_session();
   ASSERT_TRUE(bridge_.OnSensorFrame(f, host_now_ + 1000, &sample_));
   h = bridge_.Health(host_now_ + 1000, "udp test");
   EXPECT_EQ(h.state, LinkState::kDegraded);
@@ -263,6 +283,60 @@ TEST_F(BridgeTest, HealthReportsTheWorstConditionFirst) {
   h = bridge_.Health(host_now_ + 1000 + static_cast<int64_t>(hw_.link_timeout_s * 1e6) + 1, "x");
   EXPECT_EQ(h.state, LinkState::kFault);
   EXPECT_EQ(h.error, "device link down: no sensor frame for > link_timeout_s");
+}
+
+TEST_F(BridgeTest, EveryFrameCarriesTheLinkSessionDrawnAtRandom) {
+  EXPECT_NE(bridge_.link_session(), 0U);
+  const HwBridge other(hw_, 0.385, 0.2, 100.0);
+  // Two bridges (a restart) differ: 2^32 - 1 values, drawn from the OS.
+  EXPECT_NE(other.link_session(), bridge_.link_session());
+  Deliver(0);
+  EXPECT_EQ(Send().command.session, bridge_.link_session());
+  EXPECT_EQ(Send().command.session, bridge_.link_session());
+}
+
+TEST_F(BridgeTest, ZeroDriveUntilTheDeviceFollowsTheSession) {
+  // A device that still follows the bridge before this one (its session
+  // 1234), then one that follows none (power-on, or rebooted).
+  uint32_t k = 0;
+  for (const uint32_t other : {1234U, 0U}) {
+    device_session_ = other;
+    Deliver(k++);
+    ASSERT_EQ(Command(bridge_, sample_.utime, Vector6d::Constant(20.0)), CommandVerdict::kAccepted);
+    const DecodedFrame f = Send();
+    EXPECT_EQ(bridge_.last_reason(), DriveReason::kSessionPending) << other;
+    for (int16_t d : f.command.drive) EXPECT_EQ(d, 0);
+    EXPECT_EQ(bridge_.device_session(), other);
+    const LinkHealth h = bridge_.Health(host_now_, "udp test");
+    EXPECT_EQ(h.state, LinkState::kDegraded);
+    EXPECT_NE(h.error.find("follows link session " + std::to_string(other)), std::string::npos)
+        << h.error;
+    Deliver(k++);  // the same device, and still not this bridge's session
+  }
+  EXPECT_EQ(bridge_.counters().session_pending_frames, 2U);
+  EXPECT_EQ(bridge_.counters().session_pending_samples, 4U);
+  // The device echoes this bridge's session: the held command goes out.
+  device_session_.reset();
+  Deliver(k++);
+  ASSERT_EQ(Command(bridge_, sample_.utime, Vector6d::Constant(20.0)), CommandVerdict::kAccepted);
+  const DecodedFrame f = Send();
+  EXPECT_EQ(bridge_.last_reason(), DriveReason::kCommand);
+  EXPECT_EQ(f.command.drive, DriveMap(hw_, 100.0).ForceToDrive(Vector6d::Constant(20.0)).drive);
+  // The device stops following it (rebooted: no session): zero drive at once.
+  device_session_ = 0U;
+  Deliver(k++);
+  ASSERT_EQ(Command(bridge_, sample_.utime, Vector6d::Constant(20.0)), CommandVerdict::kAccepted);
+  Send();
+  EXPECT_EQ(bridge_.last_reason(), DriveReason::kSessionPending);
+}
+
+TEST_F(BridgeTest, ReportsTheDevicesSessionRejections) {
+  SensorFrame f;
+  f.adc.fill(2000);
+  f.command_session = bridge_.link_session();
+  f.rx_session_rejected = 17;
+  ASSERT_TRUE(bridge_.OnSensorFrame(f, kHostEpoch, &sample_));
+  EXPECT_EQ(bridge_.counters().device_rx_session_rejected, 17U);
 }
 
 TEST(DeviceClockMap, TracksDriftWithinTheBoundAndResetsOnReboot) {

@@ -34,11 +34,14 @@ class RecordingBackend : public DeviceBackend {
   std::vector<Segment> segments;
 };
 
+constexpr uint32_t kLinkSession = 0x5E55;  // the bridge's link session in these tests
+
 CommandFrame Command(uint32_t seq, int16_t drive, uint32_t watchdog_us = 50000) {
   CommandFrame c;
   c.seq = seq;
   c.watchdog_us = watchdog_us;
   c.drive.fill(drive);
+  c.session = kLinkSession;
   return c;
 }
 
@@ -47,11 +50,14 @@ TEST(DeviceWatchdog, ZeroDriveWhenCommandsStop) {
   DeviceEmulator device(&backend);
   SensorFrame f = device.Tick(1000);
   EXPECT_NE(f.status & kStatusActuatorsOff, 0);  // no command yet
-  device.OnCommandFrame(Command(1, 5000, 20000), 1000);
+  // The session starts at rest (zero drive), then drives.
+  EXPECT_EQ(device.OnCommandFrame(Command(1, 0, 20000), 1000), CommandAcceptance::kAdopted);
+  EXPECT_EQ(device.OnCommandFrame(Command(2, 5000, 20000), 1000), CommandAcceptance::kApplied);
   f = device.Tick(2000);
   EXPECT_EQ(backend.last[0], 5000);
   EXPECT_EQ(f.status, 0);
-  EXPECT_EQ(f.last_command_seq, 1U);
+  EXPECT_EQ(f.last_command_seq, 2U);
+  EXPECT_EQ(f.command_session, kLinkSession);
   EXPECT_EQ(f.command_age_us, 1000U);
   f = device.Tick(21000);  // exactly the watchdog period: still in force
   EXPECT_EQ(backend.last[0], 5000);
@@ -59,7 +65,7 @@ TEST(DeviceWatchdog, ZeroDriveWhenCommandsStop) {
   EXPECT_EQ(backend.last[0], 0);
   EXPECT_NE(f.status & kStatusWatchdog, 0);
   EXPECT_EQ(f.applied_drive[0], 0);
-  device.OnCommandFrame(Command(2, 7000, 20000), 22000);  // commands resume
+  device.OnCommandFrame(Command(3, 7000, 20000), 22000);  // commands resume
   f = device.Tick(23000);
   EXPECT_EQ(backend.last[0], 7000);
   EXPECT_EQ(f.status & kStatusWatchdog, 0);
@@ -89,9 +95,10 @@ TEST(DeviceWatchdog, CommandActsFromItsArrivalAndExpiresOnTime) {
   RecordingBackend backend;
   DeviceEmulator device(&backend);
   device.Tick(1000);
-  device.OnCommandFrame(Command(1, 4000, 2500), 1300);
+  device.OnCommandFrame(Command(1, 0, 2500), 1300);  // the session's start, at rest
+  device.OnCommandFrame(Command(2, 4000, 2500), 1300);
   device.Tick(2000);
-  device.OnCommandFrame(Command(2, 6000, 2500), 2250);
+  device.OnCommandFrame(Command(3, 6000, 2500), 2250);
   device.Tick(3000);
   device.Tick(5000);
   const SensorFrame f = device.Tick(6000);
@@ -326,9 +333,19 @@ void ExpectBridgePlusEmulatorEqualsPlantSim(const StackConfig& c, const SwapCont
     const std::size_t size = bridge.BuildCommandFrame(sample.utime, buffer.data());
     DecodedFrame command;
     ASSERT_EQ(DecodeDatagram(buffer.data(), size, &command), DecodeStatus::kOk);
-    device.OnCommandFrame(command.command, device_us);
-    plant.SetActuatorsOff(false);
-    plant.SetForceCommand(f_sim);
+    const CommandAcceptance accepted = device.OnCommandFrame(command.command, device_us);
+    if (k == 0) {
+      // The link session's handshake: the bridge sends zero drive until the
+      // device echoes its session (from sample 1 on), so both plants hold
+      // their legs over this first period.
+      ASSERT_EQ(bridge.last_reason(), DriveReason::kSessionPending);
+      ASSERT_EQ(accepted, CommandAcceptance::kAdopted);
+    } else {
+      ASSERT_EQ(bridge.last_reason(), DriveReason::kCommand);
+      ASSERT_EQ(accepted, CommandAcceptance::kApplied);
+      plant.SetActuatorsOff(false);
+      plant.SetForceCommand(f_sim);
+    }
     plant.Advance(kPeriodUs * 1e-6);
   }
   std::printf(

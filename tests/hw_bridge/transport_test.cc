@@ -18,6 +18,7 @@ std::vector<uint8_t> CommandBytes(uint32_t seq) {
   CommandFrame c;
   c.seq = seq;
   c.drive = {1, -2, 3, -4, 5, -6};
+  c.session = 42;
   std::vector<uint8_t> out(kMaxFrameSize);
   out.resize(EncodeCommandFrame(c, out.data()));
   return out;

@@ -24,6 +24,8 @@ SensorFrame SampleSensorFrame() {
   f.applied_drive = {-32767, -1, 0, 1, 32767, 100};
   f.rx_corrupt = 5;
   f.rx_lost = 6;
+  f.command_session = 0xCAFEF00D;
+  f.rx_session_rejected = 7;
   return f;
 }
 
@@ -33,6 +35,7 @@ CommandFrame SampleCommandFrame() {
   f.watchdog_us = 50000;
   f.drive = {-32767, -12345, 0, 1, 12345, 32767};
   f.flags = kCommandEnable;
+  f.session = 0xA1B2C3D4;
   return f;
 }
 
@@ -71,6 +74,8 @@ TEST(WireFormat, SensorFrameRoundTrip) {
   EXPECT_EQ(f.applied_drive, in.applied_drive);
   EXPECT_EQ(f.rx_corrupt, in.rx_corrupt);
   EXPECT_EQ(f.rx_lost, in.rx_lost);
+  EXPECT_EQ(f.command_session, in.command_session);
+  EXPECT_EQ(f.rx_session_rejected, in.rx_session_rejected);
 }
 
 TEST(WireFormat, CommandFrameRoundTrip) {
@@ -82,6 +87,7 @@ TEST(WireFormat, CommandFrameRoundTrip) {
   EXPECT_EQ(out.command.watchdog_us, in.watchdog_us);
   EXPECT_EQ(out.command.drive, in.drive);
   EXPECT_EQ(out.command.flags, in.flags);
+  EXPECT_EQ(out.command.session, in.session);
 }
 
 TEST(WireFormat, ByteOrderIsLittleEndianAsDocumented) {
@@ -91,7 +97,7 @@ TEST(WireFormat, ByteOrderIsLittleEndianAsDocumented) {
   // device_time_us u64 at offset 10.
   EXPECT_EQ(buf[0], 0xA5);
   EXPECT_EQ(buf[1], 0x5A);
-  EXPECT_EQ(buf[2], 1);
+  EXPECT_EQ(buf[2], 2);
   EXPECT_EQ(buf[3], 0x01);
   EXPECT_EQ(buf[4], kSensorPayloadSize);
   EXPECT_EQ(buf[5], 0);
@@ -102,10 +108,51 @@ TEST(WireFormat, ByteOrderIsLittleEndianAsDocumented) {
   // adc[0..5] from offset 18; adc[4] = 65535 at offset 26.
   EXPECT_EQ(buf[26], 0xFF);
   EXPECT_EQ(buf[27], 0xFF);
-  // CRC over bytes 2..73, little-endian at 74.
+  // Version 2: command_session u32 at offset 74, rx_session_rejected at 78.
+  EXPECT_EQ(buf[74], 0x0D);
+  EXPECT_EQ(buf[77], 0xCA);
+  EXPECT_EQ(buf[78], 7);
+  // CRC over bytes 2..81, little-endian at 82: 86 bytes in all.
+  EXPECT_EQ(kHeaderSize + kSensorPayloadSize + kCrcSize, 86U);
   const uint32_t crc = Crc32(buf.data() + 2, kHeaderSize - 2 + kSensorPayloadSize);
-  EXPECT_EQ(buf[74], crc & 0xFF);
-  EXPECT_EQ(buf[77], crc >> 24);
+  EXPECT_EQ(buf[82], crc & 0xFF);
+  EXPECT_EQ(buf[85], crc >> 24);
+}
+
+TEST(WireFormat, CommandFrameCarriesTheSessionAtOffset30) {
+  std::array<uint8_t, kMaxFrameSize> buf{};
+  const std::size_t n = EncodeCommandFrame(SampleCommandFrame(), buf.data());
+  EXPECT_EQ(n, 38U);
+  EXPECT_EQ(buf[2], 2);   // version
+  EXPECT_EQ(buf[4], 24);  // payload length
+  EXPECT_EQ(buf[28], 0);  // reserved u16
+  EXPECT_EQ(buf[29], 0);
+  EXPECT_EQ(buf[30], 0xD4);
+  EXPECT_EQ(buf[33], 0xA1);
+}
+
+TEST(WireFormat, Version1FramesAreRejected) {
+  // A device or bridge of the protocol without sessions: a clear bad_version
+  // on both sides, never a frame read with the wrong layout.
+  std::array<uint8_t, kMaxFrameSize> buf{};
+  const std::size_t n = EncodeCommandFrame(SampleCommandFrame(), buf.data());
+  buf[2] = 1;
+  const uint32_t crc = Crc32(buf.data() + 2, n - 2 - kCrcSize);
+  for (std::size_t i = 0; i < 4; ++i) buf[n - 4 + i] = static_cast<uint8_t>(crc >> (8 * i));
+  DecodedFrame out;
+  EXPECT_EQ(DecodeDatagram(buf.data(), n, &out), DecodeStatus::kBadVersion);
+}
+
+TEST(WireFormat, WhichCommandFramesAskForNoMotion) {
+  CommandFrame f = SampleCommandFrame();
+  EXPECT_FALSE(AsksForNoMotion(f));
+  f.flags = 0;  // ENABLE clear: the device applies zero drive
+  EXPECT_TRUE(AsksForNoMotion(f));
+  f = SampleCommandFrame();
+  f.drive.fill(0);
+  EXPECT_TRUE(AsksForNoMotion(f));
+  f.drive[5] = 1;
+  EXPECT_FALSE(AsksForNoMotion(f));
 }
 
 TEST(WireFormat, EverySingleBitFlipIsRejected) {
@@ -149,6 +196,10 @@ TEST(WireFormat, OutOfRangeCommandFieldsAreRejected) {
   n = EncodeCommandFrame(f, buf.data());
   EXPECT_EQ(DecodeDatagram(buf.data(), n, &out), DecodeStatus::kBadField);
   f.watchdog_us = kMinWatchdogUs - 1;
+  n = EncodeCommandFrame(f, buf.data());
+  EXPECT_EQ(DecodeDatagram(buf.data(), n, &out), DecodeStatus::kBadField);
+  f = SampleCommandFrame();
+  f.session = 0;  // "none": no bridge sends it
   n = EncodeCommandFrame(f, buf.data());
   EXPECT_EQ(DecodeDatagram(buf.data(), n, &out), DecodeStatus::kBadField);
 }

@@ -53,6 +53,7 @@ class BringupBridgeTest : public ::testing::Test {
     f.command_age_us = age_us;
     f.applied_drive = applied;
     f.status = status;
+    f.command_session = bridge_.link_session();  // the device follows this bridge
     host_now_ = kHostEpoch + 1000 * static_cast<int64_t>(k) + 100;
     return bridge_.OnSensorFrame(f, host_now_, &sample_);
   }

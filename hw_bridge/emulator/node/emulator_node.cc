@@ -109,7 +109,16 @@ void EmulatorNode::Tick(uint64_t now_us) {
 
 void EmulatorNode::OnFrame(const hw::DecodedFrame& frame, uint64_t rx_us) {
   if (frame.type == hw::FrameType::kCommand) {
-    device_.OnCommandFrame(frame.command, rx_us);
+    const uint32_t was = device_.sessions().session();
+    const hw::CommandAcceptance verdict = device_.OnCommandFrame(frame.command, rx_us);
+    if (verdict == hw::CommandAcceptance::kAdopted) {
+      spdlog::info("hw_emulator: following link session {} from seq {} (was {})",
+                   frame.command.session, frame.command.seq, was);
+    } else if (hw::IsSessionRejection(verdict) && frame.command.session != last_rejected_session_) {
+      last_rejected_session_ = frame.command.session;
+      spdlog::warn("hw_emulator: command frames of link session {} rejected ({}; following {})",
+                   frame.command.session, ToString(verdict), was);
+    }
   } else {
     device_.OnRxError();
   }

@@ -69,6 +69,7 @@ class EmulatorNode {
   int64_t start_epoch_us_ = 0;
   std::array<uint8_t, 4096> rx_{};
   std::array<uint8_t, hw::kMaxFrameSize> tx_{};
+  uint32_t last_rejected_session_ = 0;  // logged once per session, not per frame
 };
 
 /// The period of `rate_hz` in us; throws InputError naming --rate-hz when it

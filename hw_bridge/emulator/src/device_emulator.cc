@@ -4,18 +4,20 @@
 
 namespace stewart::hw {
 
-void DeviceEmulator::OnCommandFrame(const CommandFrame& frame, uint64_t now_us) {
-  if (have_command_) {
-    const auto gap = static_cast<int32_t>(frame.seq - command_.seq);
-    if (gap <= 0) return;  // duplicate or reordered: the newer one is in force
-    rx_lost_ += static_cast<uint32_t>(gap - 1);
-  }
+CommandAcceptance DeviceEmulator::OnCommandFrame(const CommandFrame& frame, uint64_t now_us) {
+  // The frame in force still drives until its watchdog expires (as in
+  // DriveFrom); one stamped before its own arrival time is still young.
+  const bool current_drives =
+      have_command_ && (now_us < command_rx_us_ || now_us - command_rx_us_ < command_.watchdog_us);
+  const CommandAcceptance verdict = sessions_.Accept(frame, current_drives);
+  if (!Applies(verdict)) return verdict;
   AdvanceTo(now_us);
   have_command_ = true;
   command_ = frame;
   // A frame stamped before the physics' time (it waited in the receive
   // queue while a sample was taken) acts from now on, never in the past.
   command_rx_us_ = std::max(now_us, physics_us_);
+  return verdict;
 }
 
 DriveArray DeviceEmulator::DriveFrom(uint64_t t_us, uint16_t* status) const {
@@ -72,7 +74,9 @@ SensorFrame DeviceEmulator::Tick(uint64_t now_us) {
   frame.command_age_us = have_command_ ? static_cast<uint32_t>(physics_us_ - command_rx_us_) : 0;
   frame.applied_drive = applied_drive_;
   frame.rx_corrupt = rx_corrupt_;
-  frame.rx_lost = rx_lost_;
+  frame.rx_lost = sessions_.rx_lost();
+  frame.command_session = sessions_.session();
+  frame.rx_session_rejected = sessions_.rx_session_rejected();
   return frame;
 }
 

@@ -9,6 +9,10 @@
 // legs (SafeCommandAcceptor, guard/), and the bridge's own last-line guard
 // on its own pot readings (ActuatorGuard) turns the drive off, latched until
 // an operator RESET (docs/operations.md, "Trust model").
+//
+// Each bridge has its own link session (link_session.h): its command frames
+// carry zero drive until the device echoes that session, i.e. follows this
+// bridge and no other (docs/wire-protocol.md, "Sessions").
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -42,20 +46,22 @@ struct SensorSample {
 /// (bringup.h) "command" is the latest duty command, else the latest safe
 /// force command.
 enum class DriveReason {
-  kCommand,   ///< the latest command, mapped
-  kMissing,   ///< no valid command received yet: zero drive
-  kStale,     ///< the held command is older than command_timeout_s: zero drive
-  kInvalid,   ///< the latest command was non-finite: zero drive
-  kDriveOff,  ///< the latest safe command says FLAG_DRIVE_OFF: zero drive
-  kGuard,     ///< the last-line guard has tripped (latched): zero drive
+  kCommand,         ///< the latest command, mapped
+  kMissing,         ///< no valid command received yet: zero drive
+  kStale,           ///< the held command is older than command_timeout_s: zero drive
+  kInvalid,         ///< the latest command was non-finite: zero drive
+  kDriveOff,        ///< the latest safe command says FLAG_DRIVE_OFF: zero drive
+  kGuard,           ///< the last-line guard has tripped (latched): zero drive
+  kSessionPending,  ///< the device does not (yet) follow this bridge's link session: zero drive
 };
-inline constexpr EnumTable<DriveReason, 6> kDriveReasonNames{{{
+inline constexpr EnumTable<DriveReason, 7> kDriveReasonNames{{{
     {DriveReason::kCommand, "command"},
     {DriveReason::kMissing, "missing"},
     {DriveReason::kStale, "stale"},
     {DriveReason::kInvalid, "invalid"},
     {DriveReason::kDriveOff, "drive_off"},
     {DriveReason::kGuard, "guard"},
+    {DriveReason::kSessionPending, "session_pending"},
 }}};
 inline const char* ToString(DriveReason reason) { return kDriveReasonNames.Name(reason).data(); }
 
@@ -115,22 +121,32 @@ struct BridgeCounters {
   uint64_t force_deadzoned =
       0;                     ///< legs whose non-zero force fell in the dead zone (frames x legs)
   uint64_t guard_trips = 0;  ///< bring-up: legs the guard tripped (events)
-  uint64_t drive_off_frames = 0;   ///< frames sent with zero drive for the supervisor's drive off
-  uint64_t guard_frames = 0;       ///< frames sent with zero drive for the tripped last-line guard
-  int64_t applied_age_max_us = 0;  ///< oldest command whose force went out (sample age, us)
+  uint64_t drive_off_frames = 0;  ///< frames sent with zero drive for the supervisor's drive off
+  uint64_t guard_frames = 0;      ///< frames sent with zero drive for the tripped last-line guard
+  uint64_t session_pending_frames = 0;   ///< frames sent with zero drive before the device's echo
+  uint64_t session_pending_samples = 0;  ///< samples whose echoed session was not this bridge's
+  int64_t applied_age_max_us = 0;        ///< oldest command whose force went out (sample age, us)
   uint64_t guard_limited_frames = 0;  ///< bring-up: frames in which the guard zeroed a leg's duty
   uint64_t device_rx_corrupt = 0;     ///< the device's own counters (latest)
   uint64_t device_rx_lost = 0;
-  WindowStats rtt_us;    ///< command round trip, per health window
-  WindowStats delay_us;  ///< host arrival - sample utime, per health window
+  uint64_t device_rx_session_rejected = 0;  ///< frames of a session the device did not adopt
+  WindowStats rtt_us;                       ///< command round trip, per health window
+  WindowStats delay_us;                     ///< host arrival - sample utime, per health window
 };
 
 class HwBridge {
  public:
   /// `bringup`: hw_bridge --bringup (bringup.h); off by default. `guard`:
   /// the config's `guard:` section (sessions, the last-line guard's limits).
+  /// The link session is drawn at random here (NewLinkSession).
   HwBridge(const HwBridgeConfig& hw, double min_length_m, double stroke_m, double force_limit_n,
            const BringupOptions& bringup = {}, const GuardConfig& guard = {});
+
+  /// This bridge's link session, in every command frame.
+  uint32_t link_session() const { return link_session_; }
+  /// The session the device follows, as its latest sensor frame echoed it
+  /// (0: none, or no frame yet).
+  uint32_t device_session() const { return device_session_; }
 
   /// A decoded sensor frame that arrived at host_rx_us. Returns false (and
   /// counts) when it must not be published: duplicate or reordered.
@@ -228,6 +244,8 @@ class HwBridge {
   DriveArray applied_drive_{};  // the device's applied drive, latest frame
   bool have_applied_ = false;
   uint32_t sent_watchdog_us_ = 0;
+  uint32_t link_session_;
+  uint32_t device_session_ = 0;
   uint32_t next_command_seq_ = 1;
   DriveReason last_reason_ = DriveReason::kMissing;
 };

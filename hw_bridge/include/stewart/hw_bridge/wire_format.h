@@ -1,5 +1,5 @@
 #pragma once
-// The device wire protocol, version 1 (docs/wire-protocol.md is the
+// The device wire protocol, version 2 (docs/wire-protocol.md is the
 // specification; this file implements it). Every multi-byte field is
 // little-endian. A frame is
 //
@@ -16,11 +16,12 @@ namespace stewart::hw {
 
 constexpr uint8_t kSync0 = 0xA5;
 constexpr uint8_t kSync1 = 0x5A;
-constexpr uint8_t kProtocolVersion = 1;
+// 2: the link session (command frames carry it, sensor frames echo it).
+constexpr uint8_t kProtocolVersion = 2;
 constexpr std::size_t kHeaderSize = 10;
 constexpr std::size_t kCrcSize = 4;
-constexpr std::size_t kSensorPayloadSize = 64;
-constexpr std::size_t kCommandPayloadSize = 20;
+constexpr std::size_t kSensorPayloadSize = 72;
+constexpr std::size_t kCommandPayloadSize = 24;
 constexpr std::size_t kMaxPayloadSize = kSensorPayloadSize;
 constexpr std::size_t kMaxFrameSize = kHeaderSize + kMaxPayloadSize + kCrcSize;
 
@@ -60,6 +61,8 @@ struct SensorFrame {
   std::array<int16_t, 6> applied_drive{};  ///< drive actually applied (after watchdog)
   uint32_t rx_corrupt = 0;                 ///< command frames the device rejected (total)
   uint32_t rx_lost = 0;                    ///< command seq gaps seen by the device (total)
+  uint32_t command_session = 0;            ///< link session the device follows (0: none yet)
+  uint32_t rx_session_rejected = 0;        ///< command frames of a session not adopted (total)
 };
 
 /// Host -> device.
@@ -68,7 +71,14 @@ struct CommandFrame {
   uint32_t watchdog_us = 50000;  ///< zero drive if no new command within this
   std::array<int16_t, 6> drive{};
   uint16_t flags = kCommandEnable;
+  /// The sending bridge's link session: random per bridge start, never 0
+  /// (docs/wire-protocol.md, "Sessions").
+  uint32_t session = 0;
 };
+
+/// Whether a command frame asks for no motion: ENABLE clear or zero drive on
+/// every leg. Only such a frame may start a session on the device.
+bool AsksForNoMotion(const CommandFrame& frame);
 
 enum class DecodeStatus {
   kOk,
@@ -78,7 +88,7 @@ enum class DecodeStatus {
   kBadType,
   kBadLength,  ///< payload length wrong for the type, or oversized datagram
   kBadCrc,
-  kBadField,  ///< CRC fine but a field out of range (drive -32768, watchdog)
+  kBadField,  ///< CRC fine but a field out of range (drive -32768, watchdog, session 0)
 };
 inline constexpr EnumTable<DecodeStatus, 8> kDecodeStatusNames{{{
     {DecodeStatus::kOk, "ok"},

@@ -10,6 +10,7 @@
 #include <cstdint>
 
 #include "stewart/hw_bridge/wire_format.h"
+#include "stewart/hw_emulator/command_session_check.h"
 #include "stewart/hw_emulator/device_backend.h"
 
 namespace stewart::hw {
@@ -18,10 +19,12 @@ class DeviceEmulator {
  public:
   explicit DeviceEmulator(DeviceBackend* backend) : backend_(backend) {}
 
-  /// A decoded command frame that arrived at device time now_us: the physics
-  /// runs up to now_us under the drive in force before it, then this frame's
-  /// drive applies. A duplicate or reordered frame (seq not newer) is ignored.
-  void OnCommandFrame(const CommandFrame& frame, uint64_t now_us);
+  /// A decoded command frame that arrived at device time now_us. When the
+  /// session check accepts it (CommandSessionCheck: its session's next
+  /// frame, or a new session's start) the physics runs up to now_us under
+  /// the drive in force before it, then this frame's drive applies; any
+  /// other frame changes nothing (and is counted when of another session).
+  CommandAcceptance OnCommandFrame(const CommandFrame& frame, uint64_t now_us);
   /// A command frame the device rejected (bad CRC, length, field ...).
   void OnRxError() { ++rx_corrupt_; }
 
@@ -32,6 +35,7 @@ class DeviceEmulator {
 
   /// Drive applied over the last stretch of physics before the latest event.
   const DriveArray& applied_drive() const { return applied_drive_; }
+  const CommandSessionCheck& sessions() const { return sessions_; }
 
  private:
   /// The drive in force over an interval starting at t_us, and the status
@@ -48,9 +52,9 @@ class DeviceEmulator {
   CommandFrame command_;
   uint64_t command_rx_us_ = 0;
   DriveArray applied_drive_{};
+  CommandSessionCheck sessions_;
   uint32_t next_seq_ = 0;
   uint32_t rx_corrupt_ = 0;
-  uint32_t rx_lost_ = 0;
 };
 
 }  // namespace stewart::hw
