@@ -216,6 +216,7 @@ RecordedLog ReadLog(const std::string& path, const ChannelNames& channels) {
       });
     }
     if (stamp) {
+      log.positions[static_cast<size_t>(channel)].push_back(static_cast<long>(log.order.size()));
       log.order.emplace_back(channel, index);
       log.order_timestamp_us.push_back(event->timestamp);
       // Operator commands: consoles share the channel and number their
@@ -236,6 +237,12 @@ RecordedLog ReadLog(const std::string& path, const ChannelNames& channels) {
     throw InputError("'" + path + "' holds no LCM event (empty, or not an LCM log)");
   }
   return log;
+}
+
+bool RecordedAfterRestart(const RecordedLog& log, Channel channel, size_t index) {
+  const SeqEvent* restart = FirstRestart(log);
+  const std::vector<long>& positions = log.positions[static_cast<size_t>(channel)];
+  return restart != nullptr && index < positions.size() && positions[index] >= restart->position;
 }
 
 void DiffStats::Add(int64_t sample_utime, const double* replayed, const double* recorded, int n,
@@ -332,8 +339,6 @@ SafetyReplayResult ReplaySafety(const StackConfig& config, const RecordedLog& lo
   // diagnostics (case, fallback reason, flags) against the recorded ones.
   std::vector<int64_t> replayed_ns, recorded_ns;
   safety_diagnostics_t replayed_diagnostics;  // reused: keeps its capacities
-  // At or after the log's first publisher restart (set per log event).
-  bool after_restart = false;
   auto compare = [&](const safety::SafetyOutput& out, bool watchdog_in_gap) {
     SafetyStep step;
     step.sample_utime = out.command.sample_utime;
@@ -350,6 +355,8 @@ SafetyReplayResult ReplaySafety(const StackConfig& config, const RecordedLog& lo
     }
     std::copy(std::begin(recorded->force_n), std::end(recorded->force_n), step.f_recorded.begin());
     step.recorded_flags = recorded->flags;
+    const bool after_restart = RecordedAfterRestart(
+        log, Channel::kCommandSafe, static_cast<size_t>(recorded - log.safe.data()));
     bool diagnostics_equal = true;
     if (const int* diag_index = Find(diagnostics_of, step.sample_utime)) {
       const RecordedDiagnostics& d = log.diagnostics[static_cast<size_t>(*diag_index)];
@@ -406,10 +413,8 @@ SafetyReplayResult ReplaySafety(const StackConfig& config, const RecordedLog& lo
   // live process's clock).
   safety::ProcessMonitor monitor(config.supervisor.required_processes,
                                  std::llround(config.supervisor.heartbeat_timeout_s * 1e6));
-  const SeqEvent* restart = FirstRestart(log);
   for (size_t e = 0; e < log.order.size(); ++e) {
     const auto& [channel, index] = log.order[e];
-    after_restart = restart != nullptr && static_cast<long>(e) >= restart->position;
     const int64_t timestamp_us = log.order_timestamp_us[e];
     const safety::SupervisorState state = process.supervisor().state();
     monitor.SetMoving(
@@ -495,11 +500,9 @@ ControllerReplayResult ReplayController(const StackConfig& config, const Scenari
   const std::optional<int64_t> origin = ControllerTimeOrigin(log, &r.time_origin_inferred);
   r.time_origin_utime = origin.value_or(-1);
   bool started = false;
-  const SeqEvent* restart = FirstRestart(log);
   // The process's OnState per recorded estimate, and its OnSupervisor per
   // recorded supervisor state (the motion clock), in log order.
-  for (size_t e = 0; e < log.order.size(); ++e) {
-    const auto& [channel, index] = log.order[e];
+  for (const auto& [channel, index] : log.order) {
     if (channel == Channel::kSupervisor) {
       const supervisor_state_t& sup = log.supervisor[static_cast<size_t>(index)];
       process.OnSupervisor(sup.utime, sup.motion_time_us,
@@ -537,7 +540,8 @@ ControllerReplayResult ReplayController(const StackConfig& config, const Scenari
     const bool flags_equal = recorded->flags == command.flags;
     if (!flags_equal) ++r.flags_differ;
     r.nominal.Add(state.sample_utime, command.force_n, recorded->force_n, 6, flags_equal,
-                  restart != nullptr && static_cast<long>(e) >= restart->position);
+                  RecordedAfterRestart(log, Channel::kCommandNominal,
+                                       static_cast<size_t>(recorded - log.nominal.data())));
   }
   recorded_commands.Finish();
   return r;
@@ -608,10 +612,6 @@ EstimatorReplayResult ReplayEstimator(const StackConfig& config, const RecordedL
                            config.home_pose, &counters, config.lcm.time_plausibility,
                            AcceptorLimitsOf(config.guard, config.estimator.command_timeout_s));
   MessageAuthenticator auth = RecordedRunAuthenticator(config);
-  // At or after the log's first publisher restart (set per log event; the
-  // perfect-state replay walks the truth alone and does not attribute).
-  const SeqEvent* restart = FirstRestart(log);
-  bool after_restart = false;
   auto compare = [&](const StateSample& sample) {
     state_t replayed{};
     ToMessage(sample, &replayed);
@@ -623,7 +623,10 @@ EstimatorReplayResult ReplayEstimator(const StackConfig& config, const RecordedL
     const bool intact =
         r.inputs_missing == 0 || replayed.sample_utime <= r.inputs_intact_until_utime;
     if (recorded.status != replayed.status && intact) ++r.status_differ;
-    (intact ? r.state : r.after_gap).Add(replayed, recorded, after_restart);
+    (intact ? r.state : r.after_gap)
+        .Add(replayed, recorded,
+             RecordedAfterRestart(log, Channel::kStateEstimate,
+                                  static_cast<size_t>(&recorded - log.estimates.data())));
   };
 
   if (r.perfect_state) {
@@ -637,7 +640,6 @@ EstimatorReplayResult ReplayEstimator(const StackConfig& config, const RecordedL
     // the log received them (the logger's receive time as the wall clock).
     for (size_t e = 0; e < log.order.size(); ++e) {
       const auto& [channel, index] = log.order[e];
-      after_restart = restart != nullptr && static_cast<long>(e) >= restart->position;
       if (channel == Channel::kSupervisor) {
         const supervisor_state_t& sup = log.supervisor[static_cast<size_t>(index)];
         process.OnAnnouncement(SessionAnnouncement{sup.utime, sup.seq, sup.session_id},

@@ -38,6 +38,12 @@ struct Heartbeat {
   std::string latched_error;
 };
 
+Heartbeat Named(const std::string& name) {
+  Heartbeat h;
+  h.name = name;
+  return h;
+}
+
 health_t HealthMessage(const Heartbeat& h, int64_t seq, int64_t utime) {
   health_t m{};
   m.utime = m.sample_utime = utime;
@@ -100,7 +106,7 @@ TEST_F(ReportTest, OnHardwareTheEstimateJudgesTheLimitsWithinItsUncertainty) {
                               health_t::STATE_OK,
                               {{"reinitialisations", 1}},
                               "sensor samples stale for 0.2 s"};
-    const Heartbeat others[] = {{"controller"}, {"safety"}};
+    const Heartbeat others[] = {Named("controller"), Named("safety")};
     for (int k = 0; k < kSamples; ++k) {
       const int64_t utime = kUtime0 + 1000 * k;
       const int64_t stamp = kLog0 + 1000 * k;
@@ -190,10 +196,10 @@ TEST_F(ReportTest, ARunWhosePlantDiedSaysSoWithTheCountersOfItsLastHeartbeat) {
               "plant_sim", health_t::STATE_OK, {{"endstop_hits", 3 * seq}, {"ticks", k}}, ""};
           AppendToLog(&log, ch.health, HealthMessage(plant, seq, utime), stamp);
         }
-        AppendToLog(&log, ch.health, HealthMessage({"estimator"}, seq, utime), stamp);
+        AppendToLog(&log, ch.health, HealthMessage(Named("estimator"), seq, utime), stamp);
         // The controller restarted between its heartbeats of 0.75 s and 1 s.
-        AppendToLog(&log, ch.health, HealthMessage({"controller"}, k < 1000 ? seq : seq - 4, utime),
-                    stamp);
+        AppendToLog(&log, ch.health,
+                    HealthMessage(Named("controller"), k < 1000 ? seq : seq - 4, utime), stamp);
       }
     }
   }

@@ -92,6 +92,8 @@ struct RecordedLog {
   /// Every decoded message above in log order: its channel and its index in
   /// that channel's vector (the estimator interleaves sensors and commands).
   std::vector<std::pair<Channel, int>> order;
+  /// By Channel, each message's index in `order`.
+  std::array<std::vector<long>, kNumChannels> positions;
   std::array<std::string, kNumChannels> channel_names;  ///< by Channel
   std::array<SeqGaps, kNumChannels> gaps;               ///< by Channel
   /// Every numbered stream of the log (the channels above, the heartbeats
@@ -112,6 +114,11 @@ struct RecordedLog {
 inline const SeqEvent* FirstRestart(const RecordedLog& log) {
   return log.continuity.first_restart();
 }
+
+/// Whether the recorded message `index` of `channel` came at or after the
+/// log's first publisher restart: a replayed output compared with it is
+/// attributed to the restart.
+bool RecordedAfterRestart(const RecordedLog& log, Channel channel, size_t index);
 
 /// Reads every event of `path`, decoding the messages on `channels`. Throws
 /// InputError when the file cannot be opened or holds no LCM event.
