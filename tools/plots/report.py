@@ -270,7 +270,7 @@ def recording_section(continuity):
         event = next((e for e in continuity["events"] if e["stream"] == name), None)
         where = (f"{event['kind']} at log +{(event['log_utime_us'] - first) * 1e-6:.3f} s "
                  f"(utime {event['utime_us']}, seq {event['previous_seq']} -> {event['seq']})"
-                 if event else "")
+                 if event else f"(not among the first {len(continuity['events'])} events listed)")
         lines.append(f"| {name} | {st['recorded']} | {st['missing']} | {st['gaps']} | "
                      f"{st['restarts']} | {where} |")
     return lines + [""], warnings
