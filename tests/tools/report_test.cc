@@ -216,7 +216,7 @@ TEST_F(ReportTest, ARunWhosePlantDiedSaysSoWithTheCountersOfItsLastHeartbeat) {
            std::string("endstop_hits 6, ticks 500."),
            std::string("| controller | ok | no | 0 | 0 | 1 (first at t = 1.000 s) |"),
            std::string("## Limits, judged on ground truth (STATE_TRUE)"),
-           std::string("Exceeded (on ground truth): none"),
+           std::string("Exceeded: none (on ground truth)"),
            std::string("x velocity lower (min -0.05 m/s)"),
        }) {
     EXPECT_NE(report.find(expected), std::string::npos) << "missing: " << expected << "\n"

@@ -344,7 +344,7 @@ def limits_section(state, on_truth, safety, t):
                 lines.append(f"| {name} | {bound:g} {unit} | {reached:.5f} | "
                              f"{max(over, 0.0):.2e} | {max(worst_sigma, 0.0):.2f} | {verdict} |")
     if on_truth:
-        lines += ["", "Exceeded (on ground truth): " + (", ".join(exceeded) or "none")]
+        lines += ["", "Exceeded: " + (", ".join(exceeded) or "none") + " (on ground truth)"]
     else:
         lines += ["", "Exceeded on the estimate (by more than its uncertainty): "
                   + (", ".join(exceeded) or "none"),
