@@ -426,6 +426,25 @@ printf "== done: %s s simulated in %.1f s wall ==\n" "$DURATION" "$WALL"
   echo "cpu_steal_s: $(awk -v a="$STEAL0" -v b="$(steal_ticks)" -v hz="$(getconf CLK_TCK)" 'BEGIN { printf "%.2f", (b - a) / hz }')"
 } >> "$OUT/run.yaml"
 
+# Whether the log holds every message the stack published (each numbers
+# its own): lcm-logger drops bursts when descheduled (docs/operations.md,
+# "Logging"), and a number computed from an incomplete log is short.
+if ((DO_LOG)); then
+  CHECK=$(find "$BUILD" -maxdepth 3 -type f -name stewart_log_export -perm -u+x -print -quit)
+  if [[ -z $CHECK ]]; then
+    echo "launch: stewart_log_export is not built: the log's completeness is not checked" >&2
+  elif [[ ! -f $LOG ]]; then
+    echo "launch: WARNING: no log at $LOG (see $OUT/logger.log)" >&2
+  else
+    COMPLETENESS=$("$CHECK" "$LOG" --check 2>&1) || true
+    if [[ $COMPLETENESS == *WARNING* ]]; then
+      echo "launch: $COMPLETENESS" >&2
+      ((LCM_LOGGER)) && echo "launch: recorded with --lcm-logger, which drops bursts of messages; the default stewart_logger does not" >&2
+    else
+      echo "   $COMPLETENESS"
+    fi
+  fi
+fi
 if ((DO_REPORT)); then
   "$ROOT/tools/report.sh" "$OUT" "$LOG"
 fi

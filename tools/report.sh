@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Writes <run>/report.md and plots from a run folder made by tools/launch.sh:
-# exports the log to CSV per channel, replays the safety filter offline as
+# exports the log to CSV per channel (and how complete it is, from the seq
+# numbers of its streams: <run>/log_continuity.json), replays the safety filter offline as
 # closed form and as QP reference on the recorded inputs (stewart_replay,
 # into <run>/replay/), then tools/plots/report.py.
 set -euo pipefail
@@ -15,7 +16,9 @@ LOG=$(realpath -m "${2:-$RUN/log.lcm}")
 BUILD=${STEWART_BUILD_DIR:-$ROOT/build}
 EXPORT=$(find "$BUILD" -maxdepth 3 -type f -name stewart_log_export -perm -u+x -print -quit)
 [[ -n $EXPORT ]] || { echo "report: stewart_log_export is not built in $BUILD" >&2; exit 2; }
-if ! "$EXPORT" "$LOG" --out "$RUN/csv" >"$RUN/csv_export.txt" 2>&1; then
+rm -f "$RUN/log_continuity.json"
+if ! "$EXPORT" "$LOG" --out "$RUN/csv" --continuity-json "$RUN/log_continuity.json" \
+    >"$RUN/csv_export.txt" 2>&1; then
   echo "report: exporting '$LOG' failed; its output ($RUN/csv_export.txt):" >&2
   tail -n 5 "$RUN/csv_export.txt" >&2
   exit 1

@@ -168,20 +168,25 @@ RecordedLog ReadLog(const std::string& path, const ChannelNames& channels) {
   };
   RecordedLog log;
   for (const auto& [name, channel] : routes) log.channel_names[static_cast<size_t>(channel)] = name;
-  std::array<std::optional<std::pair<int64_t, int64_t>>, kNumChannels> last;  // seq, utime
-  auto track = [&log, &last](Channel channel, int64_t seq, int64_t utime) {
-    const auto c = static_cast<size_t>(channel);
-    SeqGaps& gaps = log.gaps[c];
-    // Every publisher starts at seq 0: a first seq > 0 means the log lacks
-    // the channel's first messages. A seq that does not increase is a
-    // restarted publisher, not a gap.
-    const int64_t expected = last[c] ? last[c]->first + 1 : 0;
-    if (seq > expected) {
-      if (gaps.gaps == 0) gaps.intact_until_utime = last[c] ? last[c]->second : utime - 1;
+  // Every publisher starts at seq 0 and counts by one: a seq that skips is
+  // a gap (published, not recorded), one that falls back a restarted
+  // publisher (SeqContinuity).
+  auto track = [&log](Channel channel, const std::string& stream, int64_t seq, int64_t utime,
+                      int64_t timestamp) {
+    const long position = static_cast<long>(log.order.size()) - 1;
+    const std::optional<SeqEvent> event =
+        log.continuity.Observe(stream, seq, utime, timestamp, position);
+    // A heartbeat's utime is its process's newest input (0 before any):
+    // neither a data channel's gap nor the stack's time span.
+    if (channel == Channel::kHealth) return;
+    if (event && event->missing > 0) {
+      SeqGaps& gaps = log.gaps[static_cast<size_t>(channel)];
+      if (gaps.gaps == 0) {
+        gaps.intact_until_utime = event->previous_seq >= 0 ? event->previous_utime : utime - 1;
+      }
       ++gaps.gaps;
-      gaps.missing += seq - expected;
+      gaps.missing += event->missing;
     }
-    last[c] = std::make_pair(seq, utime);
     if (log.first_utime < 0 || utime < log.first_utime) log.first_utime = utime;
     log.last_utime = std::max(log.last_utime, utime);
   };
@@ -211,12 +216,18 @@ RecordedLog ReadLog(const std::string& path, const ChannelNames& channels) {
       });
     }
     if (stamp) {
+      log.positions[static_cast<size_t>(channel)].push_back(static_cast<long>(log.order.size()));
       log.order.emplace_back(channel, index);
       log.order_timestamp_us.push_back(event->timestamp);
-      // Operator commands (seq per console) and heartbeats (seq per
-      // process) share their channel between publishers: no gaps to find.
-      if (channel != Channel::kOperator && channel != Channel::kHealth) {
-        track(channel, stamp->first, stamp->second);
+      // Operator commands: consoles share the channel and number their
+      // commands each, from any start: no stream. Heartbeats: one stream
+      // per process.
+      if (channel == Channel::kHealth) {
+        const health_t& h = log.health.back();
+        track(channel, event->channel + "[" + h.name + "]", stamp->first, stamp->second,
+              event->timestamp);
+      } else if (channel != Channel::kOperator) {
+        track(channel, event->channel, stamp->first, stamp->second, event->timestamp);
       }
     } else {
       ++log.undecodable[event->channel];
@@ -228,11 +239,22 @@ RecordedLog ReadLog(const std::string& path, const ChannelNames& channels) {
   return log;
 }
 
+bool RecordedAfterRestart(const RecordedLog& log, Channel channel, size_t index) {
+  const SeqEvent* restart = FirstRestart(log);
+  const std::vector<long>& positions = log.positions[static_cast<size_t>(channel)];
+  return restart != nullptr && index < positions.size() && positions[index] >= restart->position;
+}
+
 void DiffStats::Add(int64_t sample_utime, const double* replayed, const double* recorded, int n,
-                    bool other_fields_equal) {
+                    bool other_fields_equal, bool after_restart) {
   ++compared;
   const size_t bytes = sizeof(double) * static_cast<size_t>(n);
-  if (other_fields_equal && std::memcmp(replayed, recorded, bytes) == 0) ++identical;
+  const bool same = other_fields_equal && std::memcmp(replayed, recorded, bytes) == 0;
+  if (same) ++identical;
+  if (after_restart) {
+    ++compared_after_restart;
+    if (!same) ++differing_after_restart;
+  }
   double diff = 0.0;
   double scale = 0.0;
   for (int i = 0; i < n; ++i) {
@@ -333,6 +355,8 @@ SafetyReplayResult ReplaySafety(const StackConfig& config, const RecordedLog& lo
     }
     std::copy(std::begin(recorded->force_n), std::end(recorded->force_n), step.f_recorded.begin());
     step.recorded_flags = recorded->flags;
+    const bool after_restart = RecordedAfterRestart(
+        log, Channel::kCommandSafe, static_cast<size_t>(recorded - log.safe.data()));
     bool diagnostics_equal = true;
     if (const int* diag_index = Find(diagnostics_of, step.sample_utime)) {
       const RecordedDiagnostics& d = log.diagnostics[static_cast<size_t>(*diag_index)];
@@ -358,11 +382,13 @@ SafetyReplayResult ReplaySafety(const StackConfig& config, const RecordedLog& lo
       } else {
         ++r.fallback_by_filter;
       }
-      r.fallback.Add(step.sample_utime, step.f_replayed.data(), recorded->force_n, 6, others_equal);
+      r.fallback.Add(step.sample_utime, step.f_replayed.data(), recorded->force_n, 6, others_equal,
+                     after_restart);
     } else {
       step.kind = SafetyStepKind::kCompared;
       if (!flags_equal) ++r.flags_differ;
-      r.filter.Add(step.sample_utime, step.f_replayed.data(), recorded->force_n, 6, others_equal);
+      r.filter.Add(step.sample_utime, step.f_replayed.data(), recorded->force_n, 6, others_equal,
+                   after_restart);
       replayed_ns.push_back(step.replayed_ns);
       if (step.recorded_ns >= 0) recorded_ns.push_back(step.recorded_ns);
     }
@@ -513,7 +539,9 @@ ControllerReplayResult ReplayController(const StackConfig& config, const Scenari
     if (recorded == nullptr) continue;
     const bool flags_equal = recorded->flags == command.flags;
     if (!flags_equal) ++r.flags_differ;
-    r.nominal.Add(state.sample_utime, command.force_n, recorded->force_n, 6, flags_equal);
+    r.nominal.Add(state.sample_utime, command.force_n, recorded->force_n, 6, flags_equal,
+                  RecordedAfterRestart(log, Channel::kCommandNominal,
+                                       static_cast<size_t>(recorded - log.nominal.data())));
   }
   recorded_commands.Finish();
   return r;
@@ -540,11 +568,11 @@ bool EstimateFinite(const state_t& s) {
 
 }  // namespace
 
-void EstimateDiff::Add(const state_t& replayed, const state_t& recorded) {
+void EstimateDiff::Add(const state_t& replayed, const state_t& recorded, bool after_restart) {
   const auto a = StateValues(replayed);
   const auto b = StateValues(recorded);
   values.Add(replayed.sample_utime, a.data(), b.data(), static_cast<int>(a.size()),
-             recorded.status == replayed.status && recorded.utime == replayed.utime);
+             recorded.status == replayed.status && recorded.utime == replayed.utime, after_restart);
   // In sigmas of the difference of two estimates: hypot(std_a, std_b).
   auto sigmas = [](double diff, double std_a, double std_b) {
     const double std = std::hypot(std_a, std_b);
@@ -595,7 +623,10 @@ EstimatorReplayResult ReplayEstimator(const StackConfig& config, const RecordedL
     const bool intact =
         r.inputs_missing == 0 || replayed.sample_utime <= r.inputs_intact_until_utime;
     if (recorded.status != replayed.status && intact) ++r.status_differ;
-    (intact ? r.state : r.after_gap).Add(replayed, recorded);
+    (intact ? r.state : r.after_gap)
+        .Add(replayed, recorded,
+             RecordedAfterRestart(log, Channel::kStateEstimate,
+                                  static_cast<size_t>(&recorded - log.estimates.data())));
   };
 
   if (r.perfect_state) {

@@ -22,6 +22,8 @@ ordered_json ToJson(const DiffStats& d, const char* unit_suffix) {
   j[std::string("max_abs_diff") + unit_suffix] = Number(d.max_abs_diff);
   j["max_rel_diff"] = Number(d.max_rel_diff);
   j["worst_sample_utime"] = d.worst_sample_utime;
+  j["compared_after_restart"] = d.compared_after_restart;
+  j["differing_after_restart"] = d.differing_after_restart;
   return j;
 }
 
@@ -128,7 +130,12 @@ std::string Us(const TimeStats& t) {
 }
 
 std::string Identical(const DiffStats& d) {
-  return fmt::format("{} compared, {} bit-identical", d.compared, d.identical);
+  std::string o = fmt::format("{} compared, {} bit-identical", d.compared, d.identical);
+  if (d.compared_after_restart > 0) {
+    o += fmt::format(" ({} compared after the restart, {} of them differ)",
+                     d.compared_after_restart, d.differing_after_restart);
+  }
+  return o;
 }
 
 std::string Worst(const DiffStats& d, const char* unit) {
@@ -141,6 +148,17 @@ double StackDurationS(const RecordedLog& log) {
   return log.first_utime < 0 ? 0.0 : 1e-6 * static_cast<double>(log.last_utime - log.first_utime);
 }
 
+/// Seconds from the log's first event to `timestamp_us` (the logger's clock).
+double LogTimeS(const RecordedLog& log, int64_t timestamp_us) {
+  return 1e-6 * static_cast<double>(timestamp_us - log.first_timestamp_us);
+}
+
+/// The first restart, as the summary names it.
+std::string DescribeRestart(const RecordedLog& log, const SeqEvent& e) {
+  return fmt::format("{} at utime {} (log +{:.3f} s, seq {} -> {})", e.stream, e.utime,
+                     LogTimeS(log, e.log_utime), e.previous_seq, e.seq);
+}
+
 }  // namespace
 
 long ReplayReport::Differing() const {
@@ -148,6 +166,15 @@ long ReplayReport::Differing() const {
   if (safety) n += safety->filter.differing() + safety->fallback.differing();
   if (controller) n += controller->nominal.differing();
   if (estimator) n += estimator->state.values.differing();
+  return n;
+}
+
+long ReplayReport::DifferingAfterRestart() const {
+  long n = 0;
+  if (safety)
+    n += safety->filter.differing_after_restart + safety->fallback.differing_after_restart;
+  if (controller) n += controller->nominal.differing_after_restart;
+  if (estimator) n += estimator->state.values.differing_after_restart;
   return n;
 }
 
@@ -180,12 +207,24 @@ ordered_json ToJson(const ReplayReport& report) {
                                   {"intact_until_utime", log.gaps[c].intact_until_utime}};
   }
   j["log_gaps"] = gaps;
+  ordered_json restarts = ordered_json::array();
+  for (const SeqEvent& e : log.continuity.events()) {
+    if (e.kind != SeqEventKind::kRestart) continue;
+    restarts.push_back({{"stream", e.stream},
+                        {"utime", e.utime},
+                        {"log_time_s", LogTimeS(log, e.log_utime)},
+                        {"previous_seq", e.previous_seq},
+                        {"seq", e.seq},
+                        {"missing", e.missing}});
+  }
+  j["log_restarts"] = restarts;
 
   if (report.safety) j["safety"] = ToJson(*report.safety, report.variant_source);
   if (report.controller) j["controller"] = ToJson(*report.controller);
   if (report.estimator) j["estimator"] = ToJson(*report.estimator);
   j["compared"] = report.Compared();
   j["differing"] = report.Differing();
+  j["differing_after_restart"] = report.DifferingAfterRestart();
   j["identical"] = report.Differing() == 0;
   return j;
 }
@@ -199,13 +238,42 @@ std::string FormatSummary(const ReplayReport& report) {
   for (const auto& [channel, count] : log.undecodable) {
     o += fmt::format(", {} undecodable on {}", count, channel);
   }
+  // What the log lacks and where a publisher started again, before any
+  // difference: both explain differences below.
+  long restarts = 0;
+  for (const SeqEvent& e : log.continuity.events()) {
+    if (e.kind != SeqEventKind::kRestart) continue;
+    if (++restarts > 10) continue;
+    o += fmt::format(
+        "\n  restart {}: seq fell back from {} to {} at utime {} (log +{:.3f} s): its publisher "
+        "started again",
+        e.stream, e.previous_seq, e.seq, e.utime, LogTimeS(log, e.log_utime));
+  }
+  if (restarts > 10) o += fmt::format("\n  restart ... and {} more", restarts - 10);
   for (size_t c = 0; c < log.gaps.size(); ++c) {
     if (log.gaps[c].gaps == 0) continue;
+    // The first gap's log time: its event in the continuity.
+    double first_gap_s = 0.0;
+    for (const SeqEvent& e : log.continuity.events()) {
+      if (e.stream == log.channel_names[c] && e.missing > 0) {
+        first_gap_s = LogTimeS(log, e.log_utime);
+        break;
+      }
+    }
     o += fmt::format(
         "\n  log gap {}: {} messages published but not in the log ({} burst(s), the first after "
-        "utime {})",
-        log.channel_names[c], log.gaps[c].missing, log.gaps[c].gaps,
-        log.gaps[c].intact_until_utime);
+        "utime {}, log +{:.3f} s)",
+        log.channel_names[c], log.gaps[c].missing, log.gaps[c].gaps, log.gaps[c].intact_until_utime,
+        first_gap_s);
+  }
+  if (restarts > 0) {
+    o += fmt::format(
+        "\n  A process restarted during the run: the live processes started over at the restart, "
+        "the replay's did not; outputs compared after the first restart ({}) are attributed to "
+        "it below (and still counted).",
+        DescribeRestart(log, *FirstRestart(log)));
+  } else if (log.continuity.missing() == 0) {
+    o += "\n  every stream complete: no seq gap, no restart";
   }
   o += fmt::format("\n  config  {}\n", report.config_path);
   if (!report.scenario_path.empty()) o += fmt::format("  scenario {}\n", report.scenario_path);
@@ -293,8 +361,15 @@ std::string FormatSummary(const ReplayReport& report) {
     o += fmt::format("\nResult: all {} compared outputs are bit-identical to the recorded ones.\n",
                      report.Compared());
   } else {
-    o += fmt::format("\nResult: {} of {} compared outputs differ from the recorded ones.\n",
-                     differing, report.Compared());
+    o += fmt::format("\nResult: {} of {} compared outputs differ from the recorded ones", differing,
+                     report.Compared());
+    if (const SeqEvent* restart = FirstRestart(log)) {
+      o += fmt::format(
+          "; {} of them after the restart of {}: a process started over live, the replay did "
+          "not",
+          report.DifferingAfterRestart(), DescribeRestart(log, *restart));
+    }
+    o += ".\n";
   }
   return o;
 }

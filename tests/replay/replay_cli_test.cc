@@ -15,6 +15,7 @@
 #include <filesystem>
 #include <fstream>
 #include <lcm/lcm-cpp.hpp>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -90,9 +91,10 @@ class ReplayCli : public ::testing::Test {
   /// samples [drop_from, drop_from + drop_count) are left out of the log, as
   /// lcm-logger loses a burst (the process still had them); with
   /// `tamper_case_sample` >= 0 that sample's recorded diagnostics name
-  /// another case.
+  /// another case; with `restart_sample` >= 0 the live safety process
+  /// restarts before that sample (a new process: seq from 0, DISARMED).
   std::string MakeRun(const std::string& name, int tamper_sample = -1, int drop_from = -1,
-                      int drop_count = 0, int tamper_case_sample = -1) {
+                      int drop_count = 0, int tamper_case_sample = -1, int restart_sample = -1) {
     const std::string run = root_ + "/" + name;
     fs::create_directories(run);
     const std::string config_path = std::string(STEWART_SOURCE_DIR) + "/config/platform.yaml";
@@ -110,9 +112,10 @@ class ReplayCli : public ::testing::Test {
     std::ofstream(run + "/run.yaml") << "variant: closed_form\n";
     StackConfig config = LoadStackConfig(run + "/config.yaml");
     config.safety.variant = SafetyVariant::kClosedForm;
-    HealthCounters counters("safety");
-    safety::SafetyProcess process(config.platform, config.safety, config.actuators,
-                                  config.supervisor, nullptr, &counters);
+    auto counters_ptr = std::make_unique<HealthCounters>("safety");
+    auto process_ptr =
+        std::make_unique<safety::SafetyProcess>(config.platform, config.safety, config.actuators,
+                                                config.supervisor, nullptr, counters_ptr.get());
     const ChannelNames& ch = config.lcm.channels;
 
     lcm::LogFile log(run + "/log.lcm", "w");
@@ -123,7 +126,7 @@ class ReplayCli : public ::testing::Test {
       ToMessage(out.command, &safe);
       if (k == tamper_sample) safe.force_n[0] = std::nextafter(safe.force_n[0], 1e9);
       safety_diagnostics_t diag{};
-      safety::FillDiagnosticsMessage(process.filter(), out, &diag);
+      safety::FillDiagnosticsMessage(process_ptr->filter(), out, &diag);
       if (k == tamper_case_sample) diag.active_case = diag.active_case == 0 ? 1 : 0;
       if (dropped) return;
       test::AppendToLog(&log, ch.command_safe, safe, timestamp++);
@@ -131,6 +134,14 @@ class ReplayCli : public ::testing::Test {
     };
     int64_t nominal_seq = 0;
     for (int k = 0; k < kSamples; ++k) {
+      if (k == restart_sample) {
+        process_ptr.reset();
+        counters_ptr = std::make_unique<HealthCounters>("safety");
+        process_ptr = std::make_unique<safety::SafetyProcess>(config.platform, config.safety,
+                                                              config.actuators, config.supervisor,
+                                                              nullptr, counters_ptr.get());
+      }
+      safety::SafetyProcess& process = *process_ptr;
       const bool dropped = k >= drop_from && k < drop_from + drop_count;
       const int64_t utime = 1000 * (k + 1) + (k >= kStaleSample ? kPauseUs : 0);
       const double t = 1e-3 * k;
@@ -155,9 +166,11 @@ class ReplayCli : public ::testing::Test {
       if (!dropped) test::AppendToLog(&log, ch.command_nominal, nominal, timestamp++);
       if (process.OnNominal(FromMessage(nominal), &out)) publish(out, k, dropped);
     }
-    // The process made what the assertions below count.
-    EXPECT_EQ(counters.counter("fallback_commands"), kInitializing + 1);
-    EXPECT_EQ(counters.counter("rejected_nominal_already_answered"), 1);
+    if (restart_sample < 0) {
+      // The process made what the assertions below count.
+      EXPECT_EQ(counters_ptr->counter("fallback_commands"), kInitializing + 1);
+      EXPECT_EQ(counters_ptr->counter("rejected_nominal_already_answered"), 1);
+    }
     return run;
   }
 
@@ -336,6 +349,44 @@ TEST_F(ReplayCli, WatchdogWhereTheLogLacksNominalCommandsIsNotCompared) {
   EXPECT_EQ(s.at("identical"), s.at("compared"));
   EXPECT_EQ(s.at("fallback").at("identical"), kInitializing + 1);
   EXPECT_NE(r.output.find("1 watchdog fallbacks of the replay"), std::string::npos) << r.output;
+}
+
+// The live safety process restarted mid-run (seq from 0, DISARMED, arming
+// again); the replay's process ran on. The restart is named before any
+// difference, with its time, and the differences after it are attributed to
+// it while still counted (--expect-identical fails).
+TEST_F(ReplayCli, ARestartedProcessIsNamedFirstAndItsDifferencesAttributedToIt) {
+  constexpr int kRestart = 100;
+  const std::string run = MakeRun("run", -1, -1, 0, -1, kRestart);
+  CommandResult r;
+  const nlohmann::json j = ReplayJson(run, "--expect-identical", &r);
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  const StackConfig config = LoadStackConfig(run + "/config.yaml");
+  const std::string safe = config.lcm.channels.command_safe;
+  EXPECT_TRUE(j.at("log_gaps").empty()) << j.at("log_gaps");
+  ASSERT_EQ(j.at("log_restarts").size(), 2u) << j.at("log_restarts");
+  const nlohmann::json* restart = nullptr;
+  for (const nlohmann::json& e : j.at("log_restarts")) {
+    if (e.at("stream") == safe) restart = &e;
+  }
+  ASSERT_NE(restart, nullptr) << j.at("log_restarts");
+  EXPECT_EQ(restart->at("utime"), 1000 * (kRestart + 1));
+  EXPECT_EQ(restart->at("seq"), 0);
+  EXPECT_GT(restart->at("previous_seq").get<long>(), 0);
+  const nlohmann::json& s = j.at("safety");
+  const long differing = j.at("differing").get<long>();
+  EXPECT_GT(differing, 0);
+  EXPECT_EQ(j.at("differing_after_restart").get<long>(), differing);
+  EXPECT_GT(s.at("compared_after_restart").get<long>(), 0);
+  // Before the restart, the replay reproduced every command.
+  EXPECT_EQ(s.at("identical").get<long>(),
+            s.at("compared").get<long>() - s.at("differing_after_restart").get<long>());
+  const size_t named = r.output.find("restart " + safe + ": seq fell back from");
+  ASSERT_NE(named, std::string::npos) << r.output;
+  EXPECT_LT(named, r.output.find("Safety filter:")) << r.output;
+  EXPECT_NE(r.output.find(std::to_string(differing) + " of them after the restart of"),
+            std::string::npos)
+      << r.output;
 }
 
 TEST_F(ReplayCli, OneUlpDifferenceFailsExpectIdentical) {

@@ -54,8 +54,14 @@ class TypedWriter : public CsvChannelWriter {
     return true;
   }
   std::string Header() const override { return "utime_us,seq,sample_utime_us" + Columns(); }
+  std::optional<MessageStamp> Stamp(const void* data, int size) const override {
+    Msg msg;
+    if (msg.decode(data, 0, size) != size) return std::nullopt;
+    return MessageStamp{msg.seq, msg.utime, Publisher(msg)};
+  }
 
  protected:
+  virtual std::string Publisher(const Msg& /*msg*/) const { return ""; }
   virtual std::string Columns() const = 0;
   virtual void Row(const Msg& msg, std::ostream& out) const = 0;
 };
@@ -179,6 +185,8 @@ std::string Quotable(std::string text) {
 }
 
 class HealthWriter : public TypedWriter<health_t> {
+  // Every process heartbeats on one channel, each with its own seq.
+  std::string Publisher(const health_t& m) const override { return m.name; }
   std::string Columns() const override {
     return ",name,state,worst_state,fault_latched,messages_in,messages_out,rejected_inputs,"
            "period_us,messages_in_delta,messages_out_delta,rejected_inputs_delta,counters,"
@@ -215,6 +223,11 @@ class SupervisorWriter : public TypedWriter<supervisor_state_t> {
 };
 
 class OperatorWriter : public TypedWriter<operator_command_t> {
+  // Consoles share the channel and number their commands each, from any
+  // start: no stream to check.
+  std::optional<MessageStamp> Stamp(const void* /*data*/, int /*size*/) const override {
+    return std::nullopt;
+  }
   std::string Columns() const override { return ",operator_id,command,note"; }
   void Row(const operator_command_t& m, std::ostream& out) const override {
     out << ',' << m.operator_id << ',' << int{m.command} << ",\"" << Quotable(m.note) << '"';

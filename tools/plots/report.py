@@ -1,9 +1,14 @@
 #!/usr/bin/python3
-"""Report of one run of the stack (tools/launch.sh): limits against ground
-truth, filter activity, filter compute time, sensor-to-command latency, the
-closed form against the QP reference on the recorded inputs, and the paper's
-Fig. 5 equivalent. Reads <run>/csv/*.csv, <run>/config.yaml and
-<run>/replay/{closed_form,qp}.{json,csv} (stewart_replay, run by tools/report.sh).
+"""Report of one run of the stack (tools/launch.sh): what went wrong first (an
+incomplete log, a process that stopped reporting, a run the launcher did not
+finish), the limits (on ground truth, or on the estimate with its
+uncertainty when the log has no truth; what the config limits and what it
+does not), the supervisor, every process's health, filter activity, filter
+compute time, sensor-to-command latency, the closed form against the QP
+reference on the recorded inputs, and the paper's Fig. 5 equivalent. Reads
+<run>/csv/*.csv, <run>/config.yaml, <run>/run.yaml, <run>/log_continuity.json
+(stewart_log_export) and <run>/replay/{closed_form,qp}.{json,csv}
+(stewart_replay), all made by tools/report.sh.
 
 Usage: tools/plots/report.py RUN_FOLDER    (Debian's /usr/bin/python3)
 """
@@ -38,38 +43,148 @@ def load(run, channel_key, config):
 
 
 SEVERITY = {2: 1, 3: 2}  # DEGRADED, FAULT; the other states are no problem
+HEALTH_STATES = {0: "STARTING", 1: "OK", 2: "DEGRADED", 3: "FAULT", 4: "STOPPED"}
+STATE_STOPPED = 4
+PLANTS = ("plant_sim", "hw_bridge")
+# With the estimate as the only source, a value counts as beyond a limit only
+# when it is beyond it by more than this many of the estimate's own standard
+# deviations (q_std, qd_std of that sample).
+ESTIMATE_SIGMAS = 3.0
 
 
-def health_section(run, config):
-    """Per process, from all its heartbeats: the worst state during the run (each heartbeat
-    carries the worst since the previous one), whether a fault latched, and its rejections."""
+def channel_path(run, config, key, suffix=".csv"):
     lcm = config["lcm"]
-    name = lcm["channel_prefix"] + lcm["channels"]["health"] + (lcm.get("channel_suffix") or "")
-    path = os.path.join(run, "csv", name + ".csv")
+    name = lcm["channel_prefix"] + lcm["channels"][key] + (lcm.get("channel_suffix") or "")
+    return os.path.join(run, "csv", name + suffix)
+
+
+def parse_counters(text):
+    return dict(item.split("=", 1) for item in (text or "").split(";") if "=" in item)
+
+
+def heartbeats(run, config):
+    """Every recorded heartbeat (health_t rows), per process in log order; {} without them."""
+    path = channel_path(run, config, "health")
     if not os.path.exists(path):
-        return []
+        return {}
     rows = {}
     with open(path) as f:
         for row in csv.DictReader(f):
             rows.setdefault(row["name"], []).append(row)
+    return rows
+
+
+def log_span_us(run, config, continuity):
+    """First and last receive time (us) of the log: from the continuity check, else from the
+    recorded channels' CSVs."""
+    if continuity:
+        return continuity["log_first_utime_us"], continuity["log_last_utime_us"]
+    first, last = None, None
+    folder = os.path.join(run, "csv")
+    for name in os.listdir(folder) if os.path.isdir(folder) else []:
+        if not name.endswith(".csv") or name.count(".") > 1:
+            continue
+        with open(os.path.join(folder, name)) as f:
+            rows = list(csv.DictReader(f))
+        if rows and "log_utime_us" in rows[0]:
+            first = min(first, int(rows[0]["log_utime_us"])) if first else int(rows[0]["log_utime_us"])
+            last = max(last or 0, int(rows[-1]["log_utime_us"]))
+    return first or 0, last or 0
+
+
+def restarts_of(beats):
+    """Heartbeat seq falling back: the process started again (a new process, same name)."""
+    return [b for prev, b in zip(beats, beats[1:]) if int(b["seq"]) <= int(prev["seq"])]
+
+
+def process_ends(run, config, continuity):
+    """Per process: how its reporting ended. 'stopped' (its last heartbeat says STOPPED),
+    'silent' (no STOPPED heartbeat and silent for more than 2.5 heartbeat periods before the
+    log ends: it died, was killed or hung), 'unfinished' (plant_sim ends a run by itself, so
+    without a STOPPED heartbeat it did not finish), or 'to the end'."""
+    rows = heartbeats(run, config)
+    _, log_last = log_span_us(run, config, continuity)
+    period_us = 1e6 / float(config.get("rates", {}).get("health_hz", 2.0))
+    ends = {}
+    for process, beats in rows.items():
+        last = beats[-1]
+        silent_us = log_last - int(last["log_utime_us"])
+        if int(last["state"]) == STATE_STOPPED:
+            ends[process] = ("stopped", last, silent_us)
+        elif silent_us > 2.5 * period_us:
+            ends[process] = ("silent", last, silent_us)
+        elif process == "plant_sim":
+            ends[process] = ("unfinished", last, silent_us)
+        else:
+            ends[process] = ("to the end", last, silent_us)
+    return ends
+
+
+def describe_end(process, end, t_of):
+    kind, last, silent_us = end
+    state = HEALTH_STATES.get(int(last["state"]), last["state"])
+    at = t_of(last)
+    if kind == "stopped":
+        return f"exited normally (STOPPED heartbeat at {at})"
+    if kind == "silent":
+        return (f"**stopped reporting** at {at} (its last heartbeat, state {state}), "
+                f"{silent_us * 1e-6:.1f} s before the log ends, without a STOPPED heartbeat: "
+                f"it died, was killed or hung")
+    if kind == "unfinished":
+        return (f"**did not finish**: its last heartbeat ({at}, state {state}) is not STOPPED, "
+                f"and plant_sim ends a run by itself: it died or was killed")
+    return f"reported to the end of the log (last heartbeat at {at}, state {state})"
+
+
+def health_section(run, config, t_of, continuity):
+    """Per process, from all its heartbeats: the worst state during the run (each heartbeat
+    carries the worst since the previous one), whether a fault latched, its rejections and
+    restarts, how its reporting ended, and the counters of its last heartbeat."""
+    rows = heartbeats(run, config)
     if not rows or "worst_state" not in next(iter(rows.values()))[0]:
         return []  # recorded before heartbeats carried the worst state
+    ends = process_ends(run, config, continuity)
     lines = ["## Process health", "",
              "From every heartbeat: the worst state between two heartbeats, whether a FAULT "
              "latched (and what it was), rejected inputs in total and those with an "
-             "implausible time (docs/operations.md, \"Health\").", "",
-             "| process | worst state | fault latched | rejected | time implausible |",
-             "| --- | --- | --- | --- | --- |"]
+             "implausible time, restarts (the heartbeat's seq fell back: a new process under "
+             "the same name) and how its reporting ended (docs/operations.md, \"Health\"). "
+             "Times t are stack times (the heartbeat's utime, its newest input).", "",
+             "| process | worst state | fault latched | rejected | time implausible | restarts "
+             "| end |",
+             "| --- | --- | --- | --- | --- | --- | --- |"]
     for process, beats in sorted(rows.items()):
         severity = max(SEVERITY.get(int(b["worst_state"]), 0) for b in beats)
         worst = {2: "FAULT", 1: "degraded", 0: "ok"}[severity]
         latched = [b for b in beats if b["fault_latched"] == "1"]
         last = beats[-1]
-        counters = dict(item.split("=", 1) for item in last["counters"].split(";") if "=" in item)
+        counters = parse_counters(last["counters"])
         implausible = sum(int(v) for k, v in counters.items() if k.endswith("_time_implausible"))
         latched_text = f"yes: {latched[0]['latched_error']}" if latched else "no"
-        lines.append(f"| {process} | {worst} | {latched_text} | "
-                     f"{last['rejected_inputs']} | {implausible} |")
+        restarts = restarts_of(beats)
+        restart_text = (f"{len(restarts)} (first at {t_of(restarts[0])})"
+                        if restarts else "0")
+        lines.append(f"| {process} | {worst} | {latched_text} | {last['rejected_inputs']} | "
+                     f"{implausible} | {restart_text} | "
+                     f"{describe_end(process, ends[process], t_of)} |")
+    faults = []
+    for process, beats in sorted(rows.items()):
+        seen = []
+        for b in beats:
+            for error in (b["latched_error"], b["last_error"] if int(b["state"]) == 3 else ""):
+                if error and error not in seen:
+                    seen.append(error)
+                    faults.append(f"- {process}, {t_of(b)}: {error}")
+    lines += ["", "Faults (each distinct error of a FAULT or a latched fault, first seen): "
+              + ("none." if not faults else ""), *faults]
+    lines += ["", "Counters of each process's last heartbeat (since its start; the time is "
+              "that heartbeat's):", ""]
+    for process, beats in sorted(rows.items()):
+        last = beats[-1]
+        counters = parse_counters(last["counters"])
+        text = ", ".join(f"{k} {v}" for k, v in counters.items()) or "none"
+        lines.append(f"- {process} ({t_of(last)}): messages in {last['messages_in']}, "
+                     f"out {last['messages_out']}, rejected {last['rejected_inputs']}; {text}")
     return lines + [""]
 
 
@@ -92,7 +207,8 @@ def supervisor_rows(run, config):
 
 def supervisor_section(run, config):
     """The supervisor's states through the run (docs/operations.md, "Arming and e-stop"):
-    each change with its stack time and reason, from the recorded supervisor_state_t."""
+    each change with its stack time and reason, from the recorded supervisor_state_t; the
+    HOLDs and ESTOPs counted with their reasons."""
     rows = supervisor_rows(run, config)
     if not rows:
         return []
@@ -101,37 +217,157 @@ def supervisor_section(run, config):
              "\"Arming and e-stop\"). The motion clock is the stack time spent ARMING or ARMED.",
              "", "| t (s) | state | reason |", "| --- | --- | --- |"]
     previous = None
+    stops = []
     for row in rows:
         key = (row["state"], row["transitions"])
         if key == previous:
             continue
         previous = key
         t = int(row["utime_us"]) * 1e-6
-        lines.append(f"| {t:.3f} | {SUPERVISOR_STATES.get(int(row['state']), row['state'])} | "
-                     f"{row['reason']} |")
+        state = SUPERVISOR_STATES.get(int(row["state"]), row["state"])
+        lines.append(f"| {t:.3f} | {state} | {row['reason']} |")
+        if state in ("HOLD", "ESTOP"):
+            stops.append(f"{state} at {t:.3f} s ({row['reason'] or 'no reason given'})")
     last = rows[-1]
-    lines += ["", f"At the end: {SUPERVISOR_STATES.get(int(last['state']), last['state'])}, "
+    lines += ["", f"HOLD / ESTOP: {len(stops)}" + (": " + "; ".join(stops) if stops else "") + ".",
+              "", f"At the end: {SUPERVISOR_STATES.get(int(last['state']), last['state'])}, "
               f"motion clock {int(last['motion_time_us']) * 1e-6:.3f} s, operator commands "
               f"accepted {last['operator_commands_accepted']}, rejected "
               f"{last['operator_commands_rejected']}.", ""]
     return lines
 
 
-def plant_counters(run, config):
-    """Counters of the plant process (plant_sim or hw_bridge) from its last health message."""
-    lcm = config["lcm"]
-    name = lcm["channel_prefix"] + lcm["channels"]["health"] + (lcm.get("channel_suffix") or "")
-    path = os.path.join(run, "csv", name + ".csv")
-    if not os.path.exists(path):
-        return {}
-    last = None
-    with open(path) as f:
-        for row in csv.DictReader(f):
-            if row["name"] in ("plant_sim", "hw_bridge"):
-                last = row
-    if last is None or not last["counters"]:
-        return {}
-    return dict(item.split("=", 1) for item in last["counters"].split(";") if "=" in item)
+def recording_section(continuity):
+    """How complete the log is, from the seq numbers of its streams (stewart_log_export
+    --continuity-json): messages published but not recorded, and publishers that restarted."""
+    if not continuity:
+        return ["## Recording", "", "Not checked: no log_continuity.json (tools/report.sh "
+                "writes it with stewart_log_export).", ""], []
+    first = continuity["log_first_utime_us"]
+    published = continuity["recorded"] + continuity["missing"]
+    lines = ["## Recording", ""]
+    warnings = []
+    if continuity["missing"] == 0 and continuity["restarts"] == 0:
+        lines += [f"Complete: {continuity['recorded']} numbered messages in "
+                  f"{len(continuity['streams'])} streams, no gap in any seq.", ""]
+        return lines, warnings
+    if continuity["missing"]:
+        share = 100.0 * continuity["missing"] / published
+        text = (f"the log lacks {continuity['missing']} of {published} published messages "
+                f"({share:.1f} %): every number below that counts messages is short by them "
+                f"(docs/operations.md, \"Logging\")")
+        warnings.append(text)
+        lines += [f"**Incomplete**: {text}.", ""]
+    if continuity["restarts"]:
+        text = f"{continuity['restarts']} publisher restart(s) during the run (seq fell back)"
+        warnings.append(text)
+        lines += [f"**{text[0].upper() + text[1:]}.**", ""]
+    lines += ["| stream | recorded | missing | gaps | restarts | first event |",
+              "| --- | --- | --- | --- | --- | --- |"]
+    for name, st in continuity["streams"].items():
+        if not st["missing"] and not st["restarts"]:
+            continue
+        event = next((e for e in continuity["events"] if e["stream"] == name), None)
+        where = (f"{event['kind']} at log +{(event['log_utime_us'] - first) * 1e-6:.3f} s "
+                 f"(utime {event['utime_us']}, seq {event['previous_seq']} -> {event['seq']})"
+                 if event else f"(not among the first {len(continuity['events'])} events listed)")
+        lines.append(f"| {name} | {st['recorded']} | {st['missing']} | {st['gaps']} | "
+                     f"{st['restarts']} | {where} |")
+    return lines + [""], warnings
+
+
+def plant_last_heartbeat(run, config):
+    """The plant process's (plant_sim or hw_bridge) last heartbeat row, or None."""
+    rows = heartbeats(run, config)
+    for name in PLANTS:
+        if name in rows:
+            return rows[name][-1]
+    return None
+
+
+def limits_section(state, on_truth, safety, t):
+    """Every configured limit against the state: on ground truth, the maximum reached and by
+    how much it was exceeded; on the estimate (no truth), a value beyond a limit counts only
+    when it is beyond by more than ESTIMATE_SIGMAS of the estimate's own standard deviation at
+    that sample, and is reported "on the estimate". Then every side of every axis the config
+    does not limit, with the extreme reached."""
+    if on_truth:
+        lines = ["## Limits, judged on ground truth (STATE_TRUE)", "",
+                 "| constraint | limit | max reached | exceeded by |", "| --- | --- | --- | --- |"]
+    else:
+        lines = ["## Limits, judged on the estimate (STATE_EST): no ground truth in this log", "",
+                 f"Without ground truth only the estimate is there to judge by: a limit counts as "
+                 f"exceeded on the estimate when the estimate is beyond it by more than "
+                 f"{ESTIMATE_SIGMAS:g} of its own standard deviations (q_std, qd_std) at that "
+                 f"sample; a smaller excess is within the estimate's uncertainty, not a finding "
+                 f"about the platform.", "",
+                 "| constraint | limit | max reached (estimate) | beyond by | beyond by, in "
+                 "sigmas (max) | verdict |", "| --- | --- | --- | --- | --- | --- |"]
+    exceeded, uncertain, limited = [], [], set()
+    for kind, key in (("position", "q"), ("velocity", "qd")):
+        for limit in safety.get(f"{kind}_limits") or []:
+            axis = limit["axis"]
+            linear = AXES.index(axis) < 3
+            unit = ({"q": "m", "qd": "m/s"} if linear else {"q": "rad", "qd": "rad/s"})[key]
+            suffix = ({"q": "m", "qd": "mps"} if linear else {"q": "rad", "qd": "radps"})[key]
+            values = state[f"{key}_{axis}_{suffix}"]
+            std = state.get(f"{key}_std_{axis}_{suffix}")
+            for side in ("upper", "lower"):
+                if side not in limit:
+                    continue
+                limited.add((axis, kind, side))
+                bound = limit[side]
+                reached = values.max() if side == "upper" else values.min()
+                over = (reached - bound) if side == "upper" else (bound - reached)
+                name = f"{axis} {kind} {side}"
+                if on_truth:
+                    lines.append(f"| {name} | {bound:g} {unit} | {reached:.5f} | "
+                                 f"{max(over, 0.0):.2e} |")
+                    if over > 0:
+                        exceeded.append(name)
+                    continue
+                beyond = (values - bound) if side == "upper" else (bound - values)
+                if std is not None:
+                    sigmas = np.where(std > 0, beyond / np.where(std > 0, std, 1.0),
+                                      np.where(beyond > 0, np.inf, 0.0))
+                else:
+                    sigmas = np.where(beyond > 0, np.inf, 0.0)
+                worst_sigma = float(sigmas.max()) if len(sigmas) else 0.0
+                if over <= 0:
+                    verdict = "within"
+                elif worst_sigma > ESTIMATE_SIGMAS:
+                    verdict = "exceeded on the estimate"
+                    exceeded.append(name)
+                else:
+                    verdict = f"within the estimate's uncertainty ({ESTIMATE_SIGMAS:g} sigma)"
+                    uncertain.append(name)
+                lines.append(f"| {name} | {bound:g} {unit} | {reached:.5f} | "
+                             f"{max(over, 0.0):.2e} | {max(worst_sigma, 0.0):.2f} | {verdict} |")
+    if on_truth:
+        lines += ["", "Exceeded: " + (", ".join(exceeded) or "none") + " (on ground truth)"]
+    else:
+        lines += ["", "Exceeded on the estimate (by more than its uncertainty): "
+                  + (", ".join(exceeded) or "none"),
+                  "", "Beyond a limit within the estimate's uncertainty (not judged): "
+                  + (", ".join(uncertain) or "none")]
+    unlimited = []
+    for kind, key in (("position", "q"), ("velocity", "qd")):
+        for axis in AXES:
+            linear = AXES.index(axis) < 3
+            unit = ({"q": "m", "qd": "m/s"} if linear else {"q": "rad", "qd": "rad/s"})[key]
+            suffix = ({"q": "m", "qd": "mps"} if linear else {"q": "rad", "qd": "radps"})[key]
+            values = state[f"{key}_{axis}_{suffix}"]
+            for side in ("upper", "lower"):
+                if (axis, kind, side) in limited:
+                    continue
+                reached = values.max() if side == "upper" else values.min()
+                unlimited.append(f"{axis} {kind} {side} ({'max' if side == 'upper' else 'min'} "
+                                 f"{reached:.4g} {unit})")
+    lines += ["", "Not limited by the config (safety.position_limits, safety.velocity_limits "
+              "have no such bound), so never \"exceeded\"; the extreme reached on the "
+              + ("ground truth" if on_truth else "estimate") + ": "
+              + (", ".join(unlimited) or "none") + ".", ""]
+    return lines
 
 
 def percentile(values, p):
@@ -283,37 +519,56 @@ def main():
     safe = load(run, "command_safe", config)
     setpoint = load(run, "setpoint", config)
     state = truth if truth is not None else est
-    source = "ground truth (STATE_TRUE)" if truth is not None else "estimate (STATE_EST)"
+    if state is None:
+        sys.exit(f"report: {run}: the log has neither ground truth nor state estimates "
+                 f"(channels {config['lcm']['channels']['state_truth']}, "
+                 f"{config['lcm']['channels']['state_estimate']}): nothing to report on")
+    on_truth = truth is not None
     t0 = state["utime_us"][0]
     t = (state["utime_us"] - t0) * 1e-6
+
     safety = config["safety"]
-    lines = ["# Run report", ""]
+    run_info = {}
     run_yaml = os.path.join(run, "run.yaml")
     if os.path.exists(run_yaml):
-        lines += ["```", open(run_yaml).read().strip(), "```", ""]
+        run_info = yaml.safe_load(open(run_yaml)) or {}
+    continuity = None
+    continuity_path = os.path.join(run, "log_continuity.json")
+    if os.path.exists(continuity_path):
+        with open(continuity_path) as f:
+            continuity = json.load(f)
+    log_first_us, _ = log_span_us(run, config, continuity)
 
-    lines += [f"## Limits, measured on {source}", "",
-              "| constraint | limit | max reached | exceeded by |", "| --- | --- | --- | --- |"]
-    exceeded = []
-    for kind, key, unit in (("position", "q", "m"), ("velocity", "qd", "m/s")):
-        for limit in safety[f"{kind}_limits"]:
-            axis = limit["axis"]
-            col = f"{key}_{axis}_" + ({"q": "m", "qd": "mps"}[key] if AXES.index(axis) < 3 else
-                                      {"q": "rad", "qd": "radps"}[key])
-            values = state[col]
-            for side in ("upper", "lower"):
-                if side not in limit:
-                    continue
-                bound = limit[side]
-                reached = values.max() if side == "upper" else values.min()
-                over = (reached - bound) if side == "upper" else (bound - reached)
-                lines.append(f"| {axis} {kind} {side} | {bound:g} {unit} | {reached:.5f} | "
-                             f"{max(over, 0.0):.2e} |")
-                if over > 0:
-                    exceeded.append(f"{axis} {kind} {side}")
-    lines += ["", "Exceeded: " + (", ".join(exceeded) if exceeded else "none"), ""]
+    def t_of(row):
+        """When a CSV row was: its stack time from the first state (a heartbeat's utime is its
+        newest input), or its log time when it has none yet."""
+        if int(row["utime_us"]) > 0:
+            return f"t = {(int(row['utime_us']) - t0) * 1e-6:.3f} s"
+        return (f"log +{(int(row['log_utime_us']) - log_first_us) * 1e-6:.3f} s "
+                f"(before its first input)")
+
+    # What went wrong, first: every such finding, then the sections.
+    recording_lines, warnings = recording_section(continuity)
+    if os.path.exists(run_yaml) and "wall_time_s" not in run_info:
+        warnings.append("the launcher did not finish this run (run.yaml has no wall_time_s): "
+                        "a process died or the run was interrupted; see the process logs")
+    ends = process_ends(run, config, continuity)
+    for process, end in sorted(ends.items()):
+        if end[0] in ("silent", "unfinished"):
+            warnings.append(f"{process} {describe_end(process, end, t_of)}"
+                            + (f"; its log: {process}.log"
+                               if os.path.exists(os.path.join(run, process + ".log")) else ""))
+    if not on_truth:
+        warnings.append("no ground truth in this log (on hardware there is none): the limits "
+                        "are judged on the estimate, within its uncertainty")
+    lines = ["# Run report", ""]
+    if os.path.exists(run_yaml):
+        lines += ["```", open(run_yaml).read().strip(), "```", ""]
+    lines += ["## Warnings", ""] + ([f"- {w}" for w in warnings] if warnings else ["None."])
+    lines += [""] + recording_lines
+    lines += limits_section(state, on_truth, safety, t)
     lines += supervisor_section(run, config)
-    lines += health_section(run, config)
+    lines += health_section(run, config, t_of, continuity)
 
     if diag is not None:
         dt = np.median(np.diff(diag["utime_us"])) * 1e-6 if len(diag["utime_us"]) > 1 else 0.0
@@ -340,27 +595,37 @@ def main():
                   f"{percentile(lat, 99):.0f} us, max {lat.max():.0f} us over {len(lat)} "
                   f"commands; {len(sensors['seq']) - len(lat)} samples had no safe command.", ""]
 
-        counters = plant_counters(run, config)
-        if counters and "latency_p50_us" in counters:
-            lines += [f"As the plant measures it (sample published to the first command derived "
-                      f"from it received, both on the plant's clock, so it includes the plant's "
-                      f"own wake-up; the logger's times above are the kernel's arrival times of "
-                      f"the two datagrams): p50 "
-                      f"{counters['latency_p50_us']} us, p99 {counters['latency_p99_us']} us, "
-                      f"max {counters['latency_max_us']} us over "
-                      f"{counters.get('answered_samples', '?')} answered samples.", ""]
-        if counters:
-            keys = [k for k in ("missed_ticks", "missed_stack_late", "missed_plant_late",
-                                "overrun_ticks", "tick_late_p99_us",
-                                "tick_late_max_us", "lockstep_resends",
-                                "command_timeouts", "endstop_hits", "ticks") if k in counters]
-            lines += ["Plant counters at the end (its last health message): " +
-                      ", ".join(f"{k} {counters[k]}" for k in keys) +
-                      ". missed_ticks: ticks whose previous sample got no command in time "
-                      "(real time; includes the start-up before the stack answers), split into "
-                      "missed_stack_late (the stack had at least half a period and did not "
-                      "answer) and missed_plant_late (the plant itself published that sample "
-                      "late, leaving the stack less than half a period).", ""]
+    plant = plant_last_heartbeat(run, config)
+    counters = parse_counters(plant["counters"]) if plant is not None else {}
+    if sensors is not None and safe is not None and counters and "latency_p50_us" in counters:
+        lines += [f"As the plant measures it (sample published to the first command derived "
+                  f"from it received, both on the plant's clock, so it includes the plant's "
+                  f"own wake-up; the logger's times above are the kernel's arrival times of "
+                  f"the two datagrams): p50 "
+                  f"{counters['latency_p50_us']} us, p99 {counters['latency_p99_us']} us, "
+                  f"max {counters['latency_max_us']} us over "
+                  f"{counters.get('answered_samples', '?')} answered samples.", ""]
+    if plant is not None:
+        end = ends.get(plant["name"])
+        ending = describe_end(plant["name"], end, t_of) if end else ""
+        known = [k for k in ("missed_ticks", "missed_stack_late", "missed_plant_late",
+                             "overrun_ticks", "tick_late_p99_us", "tick_late_max_us",
+                             "lockstep_resends", "command_timeouts", "endstop_hits", "ticks")
+                 if k in counters]
+        # hw_bridge has counters of its own (the device link's): all of them.
+        keys = known or list(counters)
+        shown = ", ".join(f"{k} {counters[k]}" for k in keys) or "none"
+        lines += [f"Plant counters ({plant['name']}, its last heartbeat, at "
+                  f"{t_of(plant)}, state "
+                  f"{HEALTH_STATES.get(int(plant['state']), plant['state'])}; {ending}): "
+                  f"{shown}."]
+        if "missed_ticks" in counters:
+            lines[-1] += (" missed_ticks: ticks whose previous sample got no command in time "
+                          "(real time; includes the start-up before the stack answers), split "
+                          "into missed_stack_late (the stack had at least half a period and did "
+                          "not answer) and missed_plant_late (the plant itself published that "
+                          "sample late, leaving the stack less than half a period).")
+        lines.append("")
 
     lines += replay_section(run)
 

@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "stewart/common/enum_table.h"
+#include "stewart/common/seq_continuity.h"
 #include "stewart/config/stack_config.h"
 #include "stewart/controller/scenario.h"
 #include "stewart/force_command_t.hpp"
@@ -91,15 +92,33 @@ struct RecordedLog {
   /// Every decoded message above in log order: its channel and its index in
   /// that channel's vector (the estimator interleaves sensors and commands).
   std::vector<std::pair<Channel, int>> order;
+  /// By Channel, each message's index in `order`.
+  std::array<std::vector<long>, kNumChannels> positions;
   std::array<std::string, kNumChannels> channel_names;  ///< by Channel
   std::array<SeqGaps, kNumChannels> gaps;               ///< by Channel
-  long events = 0;                                      ///< every event of the log
-  std::map<std::string, long> undecodable;              ///< per stack channel
-  int64_t first_timestamp_us = 0;                       ///< logger receive times (wall clock)
+  /// Every numbered stream of the log (the channels above, the heartbeats
+  /// per process as <health channel>[<name>]): gaps and publisher restarts,
+  /// each event's `position` its index in `order`.
+  SeqContinuity continuity;
+  long events = 0;                          ///< every event of the log
+  std::map<std::string, long> undecodable;  ///< per stack channel
+  int64_t first_timestamp_us = 0;           ///< logger receive times (wall clock)
   int64_t last_timestamp_us = 0;
   int64_t first_utime = -1;  ///< stack time span of the decoded messages (us)
   int64_t last_utime = -1;
 };
+
+/// The log's first publisher restart (a process started again during the
+/// run), or nullptr: the live processes' state starts over there, the
+/// replay's does not, so outputs after it are attributed to it.
+inline const SeqEvent* FirstRestart(const RecordedLog& log) {
+  return log.continuity.first_restart();
+}
+
+/// Whether the recorded message `index` of `channel` came at or after the
+/// log's first publisher restart: a replayed output compared with it is
+/// attributed to the restart.
+bool RecordedAfterRestart(const RecordedLog& log, Channel channel, size_t index);
 
 /// Reads every event of `path`, decoding the messages on `channels`. Throws
 /// InputError when the file cannot be opened or holds no LCM event.
@@ -113,10 +132,14 @@ struct DiffStats {
   /// Per step max_i |d_i| / max_i |recorded_i| (0 where both are 0).
   double max_rel_diff = 0.0;
   int64_t worst_sample_utime = -1;  ///< where max_abs_diff was reached
+  /// Of those compared / differing, at or after the log's first publisher
+  /// restart (FirstRestart): still counted above, and attributed to it.
+  long compared_after_restart = 0;
+  long differing_after_restart = 0;
 
   long differing() const { return compared - identical; }
   void Add(int64_t sample_utime, const double* replayed, const double* recorded, int n,
-           bool other_fields_equal);
+           bool other_fields_equal, bool after_restart = false);
 };
 
 /// How the outputs of one replayed process pair with the recorded ones, by
@@ -253,7 +276,7 @@ struct EstimateDiff {
   /// estimates, hypot(recorded std, replayed std).
   double max_diff_sigma = 0.0;
 
-  void Add(const state_t& replayed, const state_t& recorded);
+  void Add(const state_t& replayed, const state_t& recorded, bool after_restart = false);
 };
 
 struct EstimatorReplayResult {

@@ -25,6 +25,8 @@ struct ReplayReport {
   /// recorded ones, and of those compared.
   long Differing() const;
   long Compared() const;
+  /// Of Differing(), those at or after the log's first publisher restart.
+  long DifferingAfterRestart() const;
 };
 
 nlohmann::ordered_json ToJson(const ReplayReport& report);
