@@ -9,7 +9,9 @@
 // 239.255.78.0/24), so a developer's lab (stw) may be up beside it. Needs
 // root for the namespaces: skipped, saying so, without it. LCM ports
 // 8012-8013 on the lab's group.
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <sys/file.h>
 #include <unistd.h>
 
 #include <cstdio>
@@ -47,6 +49,10 @@ class HostsLab : public test::WithRunFolder<::testing::Test> {
     if (test::Shell("ip netns add stt-probe >/dev/null 2>&1 && ip netns del stt-probe") != 0) {
       GTEST_SKIP() << "this kernel or container cannot make network namespaces; not run";
     }
+    // One lab at a time: ctest runs this file's tests as separate processes.
+    lab_lock_fd_ = ::open("/tmp/stewart_hosts_lab.lock", O_CREAT | O_RDWR | O_CLOEXEC, 0600);
+    ASSERT_GE(lab_lock_fd_, 0);
+    ASSERT_EQ(::flock(lab_lock_fd_, LOCK_EX), 0);
     Lab("down");  // a lab a killed run left behind
     ASSERT_EQ(Lab("up device control observer"), 0) << "tools/netns_lab.sh up failed";
     lab_up_ = true;
@@ -65,6 +71,7 @@ class HostsLab : public test::WithRunFolder<::testing::Test> {
     if (lab_up_) {
       EXPECT_EQ(Lab("down"), 0);
     }
+    if (lab_lock_fd_ >= 0) ::close(lab_lock_fd_);  // releases the lock
     WithRunFolder::TearDown();
   }
 
@@ -77,6 +84,7 @@ class HostsLab : public test::WithRunFolder<::testing::Test> {
 
   std::string hosts_;
   bool lab_up_ = false;
+  int lab_lock_fd_ = -1;
 };
 
 TEST_F(HostsLab, NetworkCheckSaysWhoHearsWhom) {
