@@ -15,7 +15,11 @@
 namespace stewart::test {
 namespace {
 
-constexpr int kPort = 7898;  // this folder's private ports: 7820-7829, 7898
+// This folder's private ports: 7820-7829, 7898, 7899. The two tests below
+// run at the same time under ctest -j and must not share a port: the first
+// looks for (and kills) every process on its own.
+constexpr int kLaunchExitPort = 7898;
+constexpr int kReportShPort = 7899;
 
 // Matches the launched processes' command lines (their --lcm-url), not this
 // test's own shell, whose command line holds the pattern with brackets.
@@ -26,8 +30,9 @@ TEST(LaunchExit, PipedIntoHeadLeavesNoProcessBehind) {
   const std::string run = ::testing::TempDir() + "launch_exit_run";
   const std::string head = ::testing::TempDir() + "launch_exit_head.txt";
   const std::string launch = "tools/launch.sh --no-build --no-report --duration 30 --out " +
-                             ShellQuote(run) + " --lcm-url " + ShellQuote(PrivateLcmUrl(kPort)) +
-                             " | head -3 >" + ShellQuote(head);
+                             ShellQuote(run) + " --lcm-url " +
+                             ShellQuote(PrivateLcmUrl(kLaunchExitPort)) + " | head -3 >" +
+                             ShellQuote(head);
   const int code = Shell("cd " + ShellQuote(STEWART_SOURCE_DIR) +
                          " && STEWART_BUILD_DIR=" + ShellQuote(STEWART_BUILD_DIR) + " flock " +
                          ShellQuote(std::string(STEWART_BUILD_DIR) + "/stack_launch.lock") +
@@ -72,8 +77,9 @@ TEST(ReportSh, ARunRecordedElsewhereWithLogIsReported) {
   const std::string run = ::testing::TempDir() + "launch_log_elsewhere_run";
   const std::string log = ::testing::TempDir() + "launch_log_elsewhere.lcm";
   Shell("rm -rf " + ShellQuote(run) + " " + ShellQuote(log));
-  const LaunchResult launch = RunLauncher("--no-build --duration 2 --log " + ShellQuote(log), kPort,
-                                          run, ::testing::TempDir() + "launch_log.txt");
+  const LaunchResult launch =
+      RunLauncher("--no-build --duration 2 --log " + ShellQuote(log), kReportShPort, run,
+                  ::testing::TempDir() + "launch_log.txt");
   ASSERT_EQ(launch.exit_code, 0) << LaunchFailure(launch);
   EXPECT_FALSE(ReadFile(log).empty()) << "nothing recorded to " << log;
   EXPECT_NE(ReadFile(run + "/report.md").find("## Limits"), std::string::npos)
