@@ -56,10 +56,14 @@ long CountStepAllocations(bool force_limits, bool with_terms,
   return g_allocations.load() - before;
 }
 
+// Through a volatile pointer the vector escapes: the optimiser may not elide
+// its allocations (it may elide a new/delete pair nothing observes).
+std::vector<int>* volatile g_escaped_vector = nullptr;
+
 TEST(Allocation, CounterWorks) {
   const long before = g_allocations.load();
-  auto* p = new std::vector<int>(10);
-  delete p;
+  g_escaped_vector = new std::vector<int>(10);
+  delete g_escaped_vector;
   EXPECT_GE(g_allocations.load() - before, 2);
 }
 
