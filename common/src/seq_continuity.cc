@@ -9,6 +9,13 @@ std::optional<SeqEvent> SeqContinuity::Observe(const std::string& stream, int64_
   SeqStreamStats& s = streams_[stream];
   const bool first = s.recorded == 0;
   std::optional<SeqEvent> event;
+  if (!first && seq == s.last_seq && utime == s.last_utime) {
+    // The same message again (a resend): the publisher did not restart.
+    ++s.recorded;
+    ++s.repeats;
+    s.last_log_utime = log_utime;
+    return event;
+  }
   // A publisher starts at seq 0: a first recorded seq > 0 means the log
   // lacks the stream's first messages.
   const int64_t expected = first ? 0 : s.last_seq + 1;
@@ -25,7 +32,7 @@ std::optional<SeqEvent> SeqContinuity::Observe(const std::string& stream, int64_
       e.kind = SeqEventKind::kGap;
       e.missing = static_cast<long>(seq - expected);
     } else {
-      // Fell back (or repeated): a new publisher under the same name. Its
+      // Fell back (or repeated at another time): a new publisher under the same name. Its
       // messages before the first recorded one are missing too.
       e.kind = SeqEventKind::kRestart;
       e.missing = seq > 0 ? static_cast<long>(seq) : 0;

@@ -35,6 +35,14 @@ ControllerVerdict ControllerProcess::OnState(const StateSample& state, Controlle
   if (!time_check_.CheckSource(state.utime, state.sample_utime, receive_wall_us)) {
     return ControllerVerdict::kTimeImplausible;
   }
+  // A resend of the state answered last: the same answer, the control law
+  // (and the scenario clock) not stepped twice.
+  if (resend_.AnswerAgain(state.utime, state.seq, receive_wall_us)) {
+    counters_->Count("resends_answered");
+    counters_->CountOut();
+    *out = last_answer_;
+    return ControllerVerdict::kPublished;
+  }
   if (!StateUsable(state)) {
     // A real state (the estimator initialising): its time is the stack's.
     time_check_.SourceAccepted(state.utime, receive_wall_us);
@@ -70,6 +78,8 @@ ControllerVerdict ControllerProcess::OnState(const StateSample& state, Controlle
   }
   counters_->SetStackTime(state.utime, state.sample_utime);
   counters_->SetState(step.setpoint_rejected ? health_state::kDegraded : health_state::kOk);
+  last_answer_ = *out;
+  resend_.Answered(state.utime, state.seq, receive_wall_us);
   return ControllerVerdict::kPublished;
 }
 

@@ -61,6 +61,7 @@ void EstimatorNode::OnTruth(const lcm::ReceiveBuffer* rbuf, const std::string&,
 
 void EstimatorNode::Publish(const StateSample& state) {
   ToMessage(state, &state_msg_);
+  if (loss_.Drops(config_.lcm.channels.state_estimate, state_msg_.seq)) return;
   lcm_->publish(config_.lcm.channels.state_estimate, &state_msg_);
 }
 

@@ -16,6 +16,7 @@
 #include "stewart/node/health_reporter.h"
 #include "stewart/node/lcm_receiver.h"
 #include "stewart/node/message_auth.h"
+#include "stewart/node/test_loss.h"
 #include "stewart/sensor_t.hpp"
 #include "stewart/state_t.hpp"
 #include "stewart/supervisor_state_t.hpp"
@@ -37,6 +38,8 @@ class EstimatorNode {
                     const supervisor_state_t* msg);
 
   HealthReporter& health() { return health_; }
+  /// Testing only: the estimate numbered `seq` is lost on its way (TestLoss).
+  void LoseEstimateForTest(int64_t seq) { loss_.Lose(config_.lcm.channels.state_estimate, seq); }
 
  private:
   void Publish(const StateSample& state);
@@ -48,6 +51,7 @@ class EstimatorNode {
   MessageAuthenticator auth_;
   EstimatorProcess process_;
   state_t state_msg_{};
+  TestLoss loss_;
 };
 
 }  // namespace stewart

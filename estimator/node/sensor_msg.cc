@@ -8,8 +8,8 @@ namespace stewart {
 SensorSample SampleFromMessage(const sensor_t& msg) {
   SensorSample s;
   const auto fields = [](auto& x) {
-    return std::tie(x.utime, x.leg_length_m, x.gyro_radps, x.accel_mps2, x.orientation_rpy_rad,
-                    x.has_orientation);
+    return std::tie(x.utime, x.seq, x.leg_length_m, x.gyro_radps, x.accel_mps2,
+                    x.orientation_rpy_rad, x.has_orientation);
   };
   CopyFields(fields(msg), fields(s));
   s.legs_valid = (msg.status & sensor_t::STATUS_LEG_FAULT) == 0;

@@ -71,6 +71,14 @@ bool EstimatorProcess::OnSensor(const SensorSample& sample, StateSample* out,
   // Before the EKF: a sample far ahead would restart it at that time (a gap
   // over max_dt_s) and every real sample after it would be out of order.
   if (!time_check_.CheckSource(sample.utime, sample.utime, receive_wall_us)) return false;
+  // A resend of the sample answered last: the same estimate again, the EKF
+  // untouched (it must not step twice on one sample).
+  if (resend_.AnswerAgain(sample.utime, sample.seq, receive_wall_us)) {
+    counters_->Count("resends_answered");
+    counters_->CountOut();
+    *out = last_answer_;
+    return true;
+  }
   // The acceptor judges a command's age against the newest sample, as the
   // plant judges it against the newest it published.
   if (acceptor_ && sample.utime >= acceptor_->newest_sample_utime()) {
@@ -99,7 +107,13 @@ bool EstimatorProcess::OnSensor(const SensorSample& sample, StateSample* out,
   const Estimate& estimate = ekf_.estimate();
   counters_->SetState(estimate.diverged ? health_state::kDegraded : health_state::kOk);
   counters_->SetStackTime(sample.utime, sample.utime);
-  return Emit(StateFromEstimate(estimate, seq_), out);
+  if (!Emit(StateFromEstimate(estimate, seq_), out)) {
+    resend_.Clear();
+    return false;
+  }
+  last_answer_ = *out;
+  resend_.Answered(sample.utime, sample.seq, receive_wall_us);
+  return true;
 }
 
 bool EstimatorProcess::OnTruth(const StateSample& truth, StateSample* out,

@@ -8,6 +8,7 @@
 int main(int argc, char** argv) {
   std::string variant;
   bool force_limits = false;
+  int64_t lose_seq = -1;
   return stewart::NodeMain(
       argc, argv,
       {"safety", "CBF safety filter: STATE_EST + CMD_NOMINAL -> CMD_SAFE + SAFETY_DIAG"},
@@ -16,6 +17,9 @@ int main(int argc, char** argv) {
                        stewart::kSafetyVariantNames.Names() + " (default: safety.variant)");
         app.add_flag("--force-limits", force_limits,
                      "also enforce |F_i| <= actuators.force_limit_n");
+        app.add_option("--test-lose-seq", lose_seq,
+                       "do not publish the safe command with this seq, once, as if the network "
+                       "lost it (testing only)");
       },
       [&](stewart::StackConfig& config) -> std::optional<stewart::ExitCode> {
         if (!variant.empty()) {
@@ -27,6 +31,7 @@ int main(int argc, char** argv) {
       [&](const stewart::StackConfig& config, lcm::LCM* lcm) {
         stewart::safety::ClpReferenceQp reference;
         stewart::SafetyNode node(config, lcm, &reference);
+        if (lose_seq >= 0) node.LoseCommandForTest(lose_seq);
         spdlog::info("safety: variant {}, {} -> {} on {}",
                      stewart::kSafetyVariantNames.Name(config.safety.variant),
                      config.lcm.channels.command_nominal, config.lcm.channels.command_safe,

@@ -182,7 +182,9 @@ void SafetyNode::Publish(const safety::SafetyOutput& out) {
   ToMessage(out.command, &command_);
   command_.session_id = session_id_;
   auth_.Sign(&command_);
-  lcm_->publish(config_.lcm.channels.command_safe, &command_);
+  if (!loss_.Drops(config_.lcm.channels.command_safe, command_.seq)) {
+    lcm_->publish(config_.lcm.channels.command_safe, &command_);
+  }
   safety::FillDiagnosticsMessage(process_.filter(), out, &diagnostics_msg_);
   lcm_->publish(config_.lcm.channels.safety_diagnostics, &diagnostics_msg_);
 }

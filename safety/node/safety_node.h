@@ -17,6 +17,7 @@
 #include "stewart/node/health_reporter.h"
 #include "stewart/node/lcm_receiver.h"
 #include "stewart/node/message_auth.h"
+#include "stewart/node/test_loss.h"
 #include "stewart/operator_command_t.hpp"
 #include "stewart/safety/process_monitor.h"
 #include "stewart/safety/safety_process.h"
@@ -39,6 +40,9 @@ class SafetyNode {
   void OnHealth(const lcm::ReceiveBuffer*, const std::string&, const health_t* msg);
 
   int64_t session_id() const { return session_id_; }
+  /// Testing only: the safe command numbered `seq` is lost on its way
+  /// (TestLoss); its diagnostics go out.
+  void LoseCommandForTest(int64_t seq) { loss_.Lose(config_.lcm.channels.command_safe, seq); }
 
  private:
   void Publish(const safety::SafetyOutput& out);
@@ -60,6 +64,7 @@ class SafetyNode {
   const int64_t session_id_;
   OperatorCommandCheck operator_check_;
   force_command_t command_{};
+  TestLoss loss_;
   safety_diagnostics_t diagnostics_msg_{};
   supervisor_state_t supervisor_msg_{};
   int64_t announce_seq_ = 0;

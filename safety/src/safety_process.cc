@@ -43,6 +43,32 @@ const StateSample* SafetyProcess::FindState(int64_t sample_utime) const {
 
 bool SafetyProcess::OnState(const StateSample& state, SafetyOutput* out,
                             std::optional<int64_t> receive_wall_us) {
+  if (!HandleState(state, out, receive_wall_us)) return false;
+  Remember(*out, state.utime, state.seq, receive_wall_us);
+  return true;
+}
+
+bool SafetyProcess::OnNominal(const ForceCommand& nominal, SafetyOutput* out,
+                              std::optional<int64_t> receive_wall_us) {
+  if (!HandleNominal(nominal, out, receive_wall_us)) return false;
+  // Every answer of a nominal is for a state of the history (FindState).
+  const StateSample* state = FindState(out->command.sample_utime);
+  if (state != nullptr) {
+    Remember(*out, state->utime, state->seq, receive_wall_us);
+  } else {
+    resend_.Clear();
+  }
+  return true;
+}
+
+void SafetyProcess::Remember(const SafetyOutput& out, int64_t utime, int64_t seq,
+                             std::optional<int64_t> receive_wall_us) {
+  last_answer_ = out;
+  resend_.Answered(utime, seq, receive_wall_us);
+}
+
+bool SafetyProcess::HandleState(const StateSample& state, SafetyOutput* out,
+                                std::optional<int64_t> receive_wall_us) {
   counters_->CountIn();
   if (!StateFinite(state)) {
     counters_->Reject("nonfinite_state");
@@ -51,6 +77,14 @@ bool SafetyProcess::OnState(const StateSample& state, SafetyOutput* out,
   // Before it can become the newest state: one far ahead would put every
   // real state after it out of order, and be answered with its own time.
   if (!time_check_.CheckSource(state.utime, state.sample_utime, receive_wall_us)) return false;
+  // A resend of the state answered last: the same command again, the
+  // filter, the watchdog and the supervisor not stepped twice.
+  if (resend_.AnswerAgain(state.utime, state.seq, receive_wall_us)) {
+    counters_->Count("resends_answered");
+    counters_->CountOut();
+    *out = last_answer_;
+    return true;
+  }
   if (state.utime <= newest_state_utime_) {
     counters_->Reject("state_time_not_increasing");
     time_check_.SourceRejected(state.utime, receive_wall_us);
@@ -106,9 +140,16 @@ bool SafetyProcess::OnState(const StateSample& state, SafetyOutput* out,
   return false;
 }
 
-bool SafetyProcess::OnNominal(const ForceCommand& nominal, SafetyOutput* out,
-                              std::optional<int64_t> receive_wall_us) {
+bool SafetyProcess::HandleNominal(const ForceCommand& nominal, SafetyOutput* out,
+                                  std::optional<int64_t> receive_wall_us) {
   counters_->CountIn();
+  // Before anything keeps it: a non-finite nominal held for its state would
+  // displace the real one (its state answered with the invalid-input
+  // fallback, the real nominal refused as answered already).
+  if (!nominal.force_n.allFinite()) {
+    counters_->Reject("nominal_non_finite");
+    return false;
+  }
   // Against the states' time: a nominal far ahead would otherwise hold the
   // watchdog off until the states caught up with it.
   if (!time_check_.CheckOther("nominal", nominal.utime, nominal.sample_utime, receive_wall_us)) {

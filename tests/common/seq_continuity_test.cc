@@ -67,5 +67,21 @@ TEST(SeqContinuity, SeqFallingBackIsARestartNotAGap) {
   EXPECT_EQ(std::string(ToString(SeqEventKind::kRestart)), "restart");
 }
 
+TEST(SeqContinuity, TheSameMessageAgainIsARepeatNotARestart) {
+  SeqContinuity c;
+  for (int k = 0; k < 3; ++k) EXPECT_FALSE(c.Observe("A", k, 1000 * k, 50 + k, k));
+  // A lockstep resend of seq 2 (same utime), answered again: no event.
+  EXPECT_FALSE(c.Observe("A", 2, 2000, 300, 3));
+  EXPECT_FALSE(c.Observe("A", 3, 3000, 301, 4));
+  EXPECT_EQ(c.restarts(), 0);
+  EXPECT_EQ(c.missing(), 0);
+  EXPECT_EQ(c.streams().at("A").repeats, 1);
+  EXPECT_EQ(c.recorded(), 5);
+  // The same seq with another time is a publisher that started again.
+  const auto restart = c.Observe("A", 3, 9000, 302, 5);
+  ASSERT_TRUE(restart);
+  EXPECT_EQ(restart->kind, SeqEventKind::kRestart);
+}
+
 }  // namespace
 }  // namespace stewart

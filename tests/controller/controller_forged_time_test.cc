@@ -99,5 +99,53 @@ TEST(ControllerForgedTime, AReceiveTimeNeverChangesACommand) {
   }
 }
 
+TEST(ControllerResend, TheStateAnsweredLastIsAnsweredAgainWithoutASecondStep) {
+  // A lockstep resend (common/resend_answer.h): the same command and
+  // setpoint echo again, the control law and the scenario not stepped, so
+  // the commands after it are those of a run without the resend; live, a
+  // copy within 0.1 s of the answer is refused as before.
+  for (const bool live : {true, false}) {
+    SCOPED_TRACE(live ? "live" : "replay");
+    ProcessRun clean;
+    RunProcess(300, live, std::nullopt, &clean);
+    const StackConfig& c = DefaultStackConfig();
+    HealthCounters counters{"controller"};
+    ControllerProcess process(c.platform, c.controller, c.home_pose,
+                              LoadScenario(ResolveScenarioPath("paper")), &counters,
+                              c.lcm.time_plausibility);
+    std::vector<ControllerProcessOutput> outputs;
+    int answered = 0;
+    for (int k = 0; k < 300; ++k) {
+      const auto wall = [&](int64_t after_us) {
+        return live ? std::optional<int64_t>(kWall + k * kPeriodUs + after_us) : std::nullopt;
+      };
+      StateSample state = StateAt(kStartUtime + k * kPeriodUs, k);
+      state.seq = k;
+      ControllerProcessOutput out;
+      ASSERT_EQ(process.OnState(state, &out, wall(0)), ControllerVerdict::kPublished);
+      outputs.push_back(out);
+      if (k != 150) continue;
+      ControllerProcessOutput again;
+      if (live) {
+        EXPECT_EQ(process.OnState(state, &again, wall(1000)), ControllerVerdict::kStepRejected);
+      }
+      ASSERT_EQ(process.OnState(state, &again, wall(200'000)), ControllerVerdict::kPublished);
+      ++answered;
+      EXPECT_EQ(again.command.seq, out.command.seq);
+      EXPECT_EQ(again.command.force_n, out.command.force_n);
+      EXPECT_EQ(again.setpoint_echo.seq, out.setpoint_echo.seq);
+      EXPECT_EQ(again.setpoint_echo.setpoint.q_des, out.setpoint_echo.setpoint.q_des);
+    }
+    EXPECT_EQ(answered, 1);
+    EXPECT_EQ(counters.counter("resends_answered"), 1);
+    EXPECT_EQ(counters.counter("rejected_state_time_not_increasing"), live ? 1 : 0);
+    ASSERT_EQ(outputs.size(), clean.outputs.size());
+    for (size_t i = 0; i < outputs.size(); ++i) {
+      EXPECT_EQ(outputs[i].command.force_n, clean.outputs[i].command.force_n) << i;
+      EXPECT_EQ(outputs[i].command.seq, clean.outputs[i].command.seq) << i;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace stewart

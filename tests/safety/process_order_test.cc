@@ -4,6 +4,8 @@
 // replay agree bit for bit.
 #include <gtest/gtest.h>
 
+#include <limits>
+#include <optional>
 #include <vector>
 
 #include "safety_test_support.h"
@@ -162,6 +164,98 @@ TEST(SafetyProcessOrder, AfterAnEstimatorRestartLateAnswersGiveTheSameCommands) 
   EXPECT_EQ(prompt[35].fallback_reason, 0);
   EXPECT_EQ(prompt[36].fallback_reason, 0);
   EXPECT_EQ(prompt[36].state, SupervisorState::kHold);
+}
+
+// A lockstep resend of the state answered last (common/resend_answer.h):
+// the same command again, the filter, watchdog and supervisor not stepped,
+// so the answers after it are those without the resend. A NaN nominal is
+// refused before it can wait for its state and displace the real one.
+std::vector<Answer> AnswersWithFaults(bool live, int resend_at, int nan_nominal_at,
+                                      HealthCounters* counters, int* answered_again) {
+  const StackConfig& c = DefaultConfig();
+  SafetyProcess process(c.platform, c.safety, c.actuators, ArmedAtOnce(), nullptr, counters);
+  const Vector6d q = c.home_pose;
+  const Vector6d f_des = HoverForce(q) + Vector6d::Constant(0.5);
+  std::vector<Answer> answers;
+  for (int k = 0; k < 8; ++k) {
+    const int64_t utime = 1'000'000 + 1000 * k;
+    const auto wall = [&](int64_t after_us) {
+      return live ? std::optional<int64_t>(5'000'000 + utime + after_us) : std::nullopt;
+    };
+    StateSample state;
+    state.utime = state.sample_utime = utime;
+    state.seq = k;
+    state.q = q;
+    state.status = kStateValid;
+    ForceCommand nominal;
+    nominal.utime = nominal.sample_utime = utime;
+    nominal.seq = k;
+    nominal.force_n = f_des;
+    SafetyOutput out;
+    if (k == nan_nominal_at) {
+      // Ahead of its state, as a nominal may overtake it on the bus.
+      ForceCommand poisoned = nominal;
+      poisoned.force_n(2) = std::numeric_limits<double>::quiet_NaN();
+      EXPECT_FALSE(process.OnNominal(poisoned, &out, wall(0)));
+    }
+    if (process.OnState(state, &out, wall(0))) {
+      ADD_FAILURE() << "no answer before the nominal at " << k;
+    }
+    EXPECT_TRUE(process.OnNominal(nominal, &out, wall(10)));
+    answers.push_back({out.command.sample_utime, out.command.force_n, out.command.flags,
+                       out.fallback_reason, out.mode.state});
+    EXPECT_TRUE(out.diagnostics->f_des.allFinite());
+    if (k != resend_at) continue;
+    const SafetyOutput first = out;
+    SafetyOutput again;
+    if (live) {
+      EXPECT_FALSE(process.OnState(state, &again, wall(1000)));
+    }
+    if (process.OnState(state, &again, wall(200'000))) {
+      ++*answered_again;
+      EXPECT_EQ(again.command.seq, first.command.seq);
+      EXPECT_EQ(again.command.force_n, first.command.force_n);
+      EXPECT_EQ(again.command.flags, first.command.flags);
+      EXPECT_EQ(again.diagnostics->f_safe, first.diagnostics->f_safe);
+    }
+    // The nominal resent by the controller as well: answered once already.
+    EXPECT_FALSE(process.OnNominal(nominal, &again, wall(200'010)));
+  }
+  return answers;
+}
+
+TEST(SafetyProcessResend, TheStateAnsweredLastIsAnsweredAgainWithoutASecondStep) {
+  for (const bool live : {true, false}) {
+    SCOPED_TRACE(live ? "live" : "replay");
+    HealthCounters clean_counters("clean"), counters("resend");
+    int unused = 0, answered = 0;
+    const std::vector<Answer> reference = AnswersWithFaults(live, -1, -1, &clean_counters, &unused);
+    const std::vector<Answer> resent = AnswersWithFaults(live, 4, -1, &counters, &answered);
+    EXPECT_EQ(answered, 1);
+    EXPECT_EQ(counters.counter("resends_answered"), 1);
+    EXPECT_EQ(counters.counter("rejected_state_time_not_increasing"), live ? 1 : 0);
+    ASSERT_EQ(resent.size(), reference.size());
+    for (size_t k = 0; k < reference.size(); ++k) {
+      EXPECT_EQ(resent[k].sample_utime, reference[k].sample_utime) << k;
+      EXPECT_EQ(resent[k].force_n, reference[k].force_n) << k;
+      EXPECT_EQ(resent[k].flags, reference[k].flags) << k;
+      EXPECT_EQ(resent[k].state, reference[k].state) << k;
+    }
+  }
+}
+
+TEST(SafetyProcessResend, ANonFiniteNominalIsRefusedBeforeItWaitsForItsState) {
+  HealthCounters clean_counters("clean"), counters("nan");
+  int unused = 0;
+  const std::vector<Answer> reference = AnswersWithFaults(true, -1, -1, &clean_counters, &unused);
+  const std::vector<Answer> poisoned = AnswersWithFaults(true, -1, 3, &counters, &unused);
+  EXPECT_EQ(counters.counter("rejected_nominal_non_finite"), 1);
+  EXPECT_EQ(counters.counter("nominal_before_state"), 0);
+  ASSERT_EQ(poisoned.size(), reference.size());
+  for (size_t k = 0; k < reference.size(); ++k) {
+    EXPECT_EQ(poisoned[k].force_n, reference[k].force_n) << k;
+    EXPECT_EQ(poisoned[k].flags, reference[k].flags) << k;
+  }
 }
 
 }  // namespace

@@ -4,7 +4,10 @@
 // every channel, one after the other for a second each: a flood of first
 // fragments each declaring 16 MiB (1000 per second), random datagrams (1000
 // per second), and the stack's own messages sent again cut short, with the
-// wrong fingerprint, duplicated, 10 s stale and 10 s in the future.
+// wrong fingerprint, duplicated, 10 s stale and 10 s in the future; then
+// the loop's messages resent with NaN and with Inf values (a plausible time,
+// values to refuse), and the sensor clock jumping 0.5 s back and 0.5 s
+// forward for a second each (a second time base within lcm.time_window_s).
 //
 // For the whole run: no process dies, no loop stalls (the sensor stream and
 // every heartbeat keep coming), every limit holds on the recorded ground
@@ -21,19 +24,26 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <lcm/lcm-cpp.hpp>
 #include <map>
+#include <set>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "stewart/config/config_loader.h"
+#include "stewart/force_command_t.hpp"
 #include "stewart/health_t.hpp"
 #include "stewart/node/lcm_handle.h"
 #include "stewart/node/lcm_receiver.h"
+#include "stewart/safety_diagnostics_t.hpp"
 #include "stewart/sensor_t.hpp"
+#include "stewart/setpoint_t.hpp"
+#include "stewart/state_t.hpp"
 #include "stewart/supervisor_state_t.hpp"
 #include "stewart/test_support/child_process.h"
 #include "stewart/test_support/recorded_run.h"
@@ -53,8 +63,78 @@ int64_t Counter(const health_t& h, const std::string& name) {
   return 0;
 }
 
+template <typename T, size_t N>
+bool Finite(const T (&values)[N]) {
+  return std::all_of(std::begin(values), std::end(values), [](T v) { return std::isfinite(v); });
+}
+bool Finite(const std::vector<double>& values) {
+  return std::all_of(values.begin(), values.end(), [](double v) { return std::isfinite(v); });
+}
+bool Finite(const sensor_t& m) {
+  return Finite(m.leg_length_m) && Finite(m.gyro_radps) && Finite(m.accel_mps2) &&
+         Finite(m.orientation_rpy_rad);
+}
+bool Finite(const state_t& m) {
+  return Finite(m.q) && Finite(m.qd) && Finite(m.q_std) && Finite(m.qd_std) &&
+         Finite(m.disturbance) && Finite(m.disturbance_std);
+}
+bool Finite(const force_command_t& m) { return Finite(m.force_n); }
+bool Finite(const setpoint_t& m) {
+  return Finite(m.q_des) && Finite(m.qd_des) && Finite(m.qdd_des);
+}
+bool Finite(const safety_diagnostics_t& m) {
+  const double scalars[] = {m.h_pos, m.h_vel, m.psi_p,           m.psi_v,
+                            m.mu_p,  m.mu_v,  m.correction_norm, m.nominal_scale};
+  return Finite(scalars) && Finite(m.h_position) && Finite(m.alpha_h_position) &&
+         Finite(m.w_position) && Finite(m.mu_position) && Finite(m.h_velocity) &&
+         Finite(m.alpha_h_velocity) && Finite(m.w_velocity) && Finite(m.mu_velocity) &&
+         Finite(m.g_p) && Finite(m.g_v) && Finite(m.mu_force) && Finite(m.f_des) &&
+         Finite(m.f_nominal) && Finite(m.f_safe);
+}
+
+/// Non-finite messages on one channel, told apart by their origin: a copy
+/// stewart_inject poisoned carries the utime of a finite message heard on
+/// the channel and that message's seq + 1 (no publisher of the stack sends
+/// two messages with one utime and consecutive seqs); any other non-finite
+/// message came from the stack.
+struct NonFiniteWatch {
+  template <typename Msg>
+  void Observe(const Msg& m) {
+    if (Finite(m)) {
+      finite.emplace(m.utime, m.seq);
+    } else {
+      non_finite.emplace_back(m.utime, m.seq);
+    }
+  }
+  /// Poisoned copies (`injected`) and the rest, the stack's own.
+  long FromStack(long* injected) const {
+    long own = 0;
+    *injected = 0;
+    for (const auto& [utime, seq] : non_finite) {
+      (finite.count({utime, seq - 1}) ? *injected : own) += 1;
+    }
+    return own;
+  }
+  std::set<std::pair<int64_t, int64_t>> finite;
+  std::vector<std::pair<int64_t, int64_t>> non_finite;
+};
+
 struct Bus {
-  void OnSensor(const lcm::ReceiveBuffer* b, const std::string&, const sensor_t* m) {
+  template <typename Msg>
+  void Watch(const lcm::ReceiveBuffer*, const std::string& channel, const Msg* m) {
+    watch[channel].Observe(*m);
+  }
+  void OnEstimate(const lcm::ReceiveBuffer* b, const std::string& channel, const state_t* m) {
+    Watch(b, channel, m);
+    last_estimate_utime = std::max(last_estimate_utime, m->utime);
+    if (Finite(*m)) last_finite_estimate_utime = m->utime;
+  }
+  void OnSensor(const lcm::ReceiveBuffer* b, const std::string& channel, const sensor_t* m) {
+    watch[channel].Observe(*m);
+    // The plant's samples only: resent, poisoned or jumped copies repeat
+    // or trail its seq.
+    if (m->seq <= last_sensor_seq || !Finite(*m)) return;
+    last_sensor_utime = m->utime;
     last_sensor_seq = m->seq;
     if (last_sensor_us > 0)
       longest_sensor_gap_us = std::max(longest_sensor_gap_us, b->recv_utime - last_sensor_us);
@@ -75,6 +155,10 @@ struct Bus {
   }
   int64_t sensors = 0;
   int64_t last_sensor_seq = -1;
+  int64_t last_sensor_utime = 0;
+  int64_t last_estimate_utime = 0;
+  int64_t last_finite_estimate_utime = 0;
+  std::map<std::string, NonFiniteWatch> watch;
   int64_t last_sensor_us = 0;
   int64_t longest_sensor_gap_us = 0;
   std::map<std::string, int64_t> last_health_us, longest_health_gap_us;
@@ -96,6 +180,9 @@ int64_t SensorSamplesMissingFromLog(const std::string& log_path, const std::stri
     if (event->channel != channel) continue;
     sensor_t s;
     if (s.decode(event->data, 0, event->datalen) < 0) continue;
+    // The plant's samples only: resent, poisoned or jumped copies repeat or
+    // trail its seq.
+    if (s.seq <= last_seq || !Finite(s)) continue;
     ++*recorded;
     if (last_seq >= 0 && s.seq > last_seq + 1) {
       (s.seq <= before_seq ? missing : *missing_later) += s.seq - last_seq - 1;
@@ -128,6 +215,11 @@ TEST(BusFaults, HostileTrafficOnEveryChannelIsCountedAndChangesNothingUnsafe) {
   LcmReceiver receiver(url);
   Bus bus;
   receiver.Subscribe(ch.sensors, &Bus::OnSensor, &bus);
+  receiver.Subscribe(ch.state_estimate, &Bus::OnEstimate, &bus);
+  receiver.Subscribe(ch.command_nominal, &Bus::Watch<force_command_t>, &bus);
+  receiver.Subscribe(ch.command_safe, &Bus::Watch<force_command_t>, &bus);
+  receiver.Subscribe(ch.setpoint, &Bus::Watch<setpoint_t>, &bus);
+  receiver.Subscribe(ch.safety_diagnostics, &Bus::Watch<safety_diagnostics_t>, &bus);
   receiver.Subscribe(ch.health, &Bus::OnHealth, &bus);
   receiver.Subscribe(ch.supervisor, &Bus::OnSupervisor, &bus);
   const auto pump_until = [&](auto done, double timeout_s) {
@@ -144,7 +236,7 @@ TEST(BusFaults, HostileTrafficOnEveryChannelIsCountedAndChangesNothingUnsafe) {
       },
       15.0))
       << "the stack did not come up";
-  constexpr double kDurationS = 14.0;
+  constexpr double kDurationS = 21.0;
   test::ChildProcess plant(
       with({PLANT_SIM_PATH, "--mode", "realtime", "--duration", std::to_string(kDurationS)}));
   ASSERT_TRUE(plant.started());
@@ -174,23 +266,71 @@ TEST(BusFaults, HostileTrafficOnEveryChannelIsCountedAndChangesNothingUnsafe) {
       {"duplicate", {"--rate-hz", "500"}},
       {"stale", {"--rate-hz", "500", "--shift-s", "10"}},
       {"future", {"--rate-hz", "500", "--shift-s", "10"}},
+      // The loop's messages with a plausible time and NaN / Inf values; not
+      // the ground truth, which no process of this stack reads and which is
+      // this test's reference.
+      {"nan",
+       {"--rate-hz", "500", "--channel", ch.sensors, "--channel", ch.state_estimate, "--channel",
+        ch.setpoint, "--channel", ch.command_nominal, "--channel", ch.command_safe}},
+      {"inf",
+       {"--rate-hz", "500", "--channel", ch.sensors, "--channel", ch.state_estimate, "--channel",
+        ch.setpoint, "--channel", ch.command_nominal, "--channel", ch.command_safe}},
+      // A second sensor clock, within lcm.time_window_s of the plant's: back,
+      // then forward (last: see docs/operations.md, "Time plausibility").
+      {"clock-jump-back", {"--rate-hz", "5000", "--shift-s", "-0.5"}},
+      {"clock-jump-forward", {"--rate-hz", "5000", "--shift-s", "0.5"}},
+  };
+  const std::vector<std::string> watched = {ch.sensors,         ch.state_estimate,
+                                            ch.command_nominal, ch.command_safe,
+                                            ch.setpoint,        ch.safety_diagnostics};
+  const auto injected_now = [&] {
+    std::map<std::string, long> n;
+    for (const std::string& c : watched) bus.watch[c].FromStack(&n[c]);
+    return n;
   };
   std::map<std::string, health_t> before, after;
+  std::map<std::string, std::map<std::string, health_t>> before_all, after_all;
+  std::map<std::string, std::map<std::string, long>> injected_before, injected_after;
   std::map<std::string, int64_t> first_sample;
+  double jump_recovery_s = -1.0;
+  int8_t supervisor_before_jump = -1;
   for (const Fault& fault : faults) {
     before[fault.mode] = bus.health["safety"];
+    before_all[fault.mode] = bus.health;
+    if (fault.mode == "clock-jump-forward" && !bus.supervisor.empty()) {
+      supervisor_before_jump = bus.supervisor.back().state;
+    }
+    injected_before[fault.mode] = injected_now();
     first_sample[fault.mode] = bus.last_sensor_seq;
     std::printf("[bus faults] %s from sensor sample %lld\n", fault.mode.c_str(),
                 static_cast<long long>(bus.last_sensor_seq));
-    std::vector<std::string> argv = {INJECT_PATH, "--mode", fault.mode, "--duration-s", "1.0"};
+    const std::string mode = fault.mode.rfind("clock-jump", 0) == 0 ? "clock-jump" : fault.mode;
+    std::vector<std::string> argv = {INJECT_PATH, "--mode", mode, "--duration-s", "1.0"};
     argv.insert(argv.end(), fault.extra.begin(), fault.extra.end());
     test::ChildProcess inject(with(argv));
     ASSERT_TRUE(inject.started());
     ASSERT_TRUE(pump_until([&] { return !inject.running(); }, 10.0)) << fault.mode;
     EXPECT_EQ(inject.exit_code(), 0) << fault.mode;
+    if (fault.mode == "clock-jump-forward") {
+      // Back on the plant's clock: the estimates follow the plant's samples
+      // again (a jump of 0.5 s: the old clock's samples are out of order
+      // until it has passed the newest jumped one).
+      const auto end = std::chrono::steady_clock::now();
+      if (pump_until(
+              [&] {
+                return bus.last_finite_estimate_utime <= bus.last_sensor_utime &&
+                       bus.last_sensor_utime - bus.last_finite_estimate_utime < 20'000;
+              },
+              3.0)) {
+        jump_recovery_s =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - end).count();
+      }
+    }
     // A heartbeat after the fault ended (2 Hz).
     pump_until([] { return false; }, 0.6);
     after[fault.mode] = bus.health["safety"];
+    after_all[fault.mode] = bus.health;
+    injected_after[fault.mode] = injected_now();
   }
   ASSERT_TRUE(pump_until([&] { return !plant.running(); }, kDurationS + 20.0))
       << "plant_sim did not finish";
@@ -244,6 +384,89 @@ TEST(BusFaults, HostileTrafficOnEveryChannelIsCountedAndChangesNothingUnsafe) {
   EXPECT_GT(rejected("duplicate"), 0);
   EXPECT_GT(rejected("stale"), 0);
   EXPECT_GT(rejected("future"), 0);
+
+  // No process published a non-finite value, whatever it was sent.
+  for (const std::string& c : watched) {
+    long injected = 0;
+    EXPECT_EQ(bus.watch[c].FromStack(&injected), 0) << "non-finite values published on " << c;
+    std::printf("[bus faults] %s: %zu finite, %ld poisoned copies heard\n", c.c_str(),
+                bus.watch[c].finite.size(), injected);
+  }
+  // Each poisoned copy refused by the process that received it, counted
+  // under its name: the copies the test heard against the counter's growth
+  // (a process or the test may miss a datagram of a flood; printed).
+  const auto grew = [&](const std::string& mode, const std::string& process,
+                        const std::string& counter) {
+    return Counter(after_all[mode][process], counter) - Counter(before_all[mode][process], counter);
+  };
+  const auto heard = [&](const std::string& mode, const std::string& channel) {
+    return injected_after[mode][channel] - injected_before[mode][channel];
+  };
+  for (const std::string mode : {"nan", "inf"}) {
+    const long states = heard(mode, ch.state_estimate), nominals = heard(mode, ch.command_nominal);
+    const long samples = heard(mode, ch.sensors), safe = heard(mode, ch.command_safe);
+    std::printf(
+        "[bus faults] %s copies heard: %ld states, %ld nominal, %ld samples, %ld safe commands; "
+        "controller state_non_finite +%lld, safety nonfinite_state +%lld, nominal_non_finite "
+        "+%lld, estimator non_increasing_time +%lld, command_non_finite +%lld, plant_sim "
+        "command_unauthentic +%lld\n",
+        mode.c_str(), states, nominals, samples, safe,
+        static_cast<long long>(grew(mode, "controller", "rejected_state_non_finite")),
+        static_cast<long long>(grew(mode, "safety", "rejected_nonfinite_state")),
+        static_cast<long long>(grew(mode, "safety", "rejected_nominal_non_finite")),
+        static_cast<long long>(grew(mode, "estimator", "rejected_non_increasing_time")),
+        static_cast<long long>(grew(mode, "estimator", "rejected_command_non_finite")),
+        static_cast<long long>(grew(mode, "plant_sim", "rejected_command_unauthentic")));
+    EXPECT_GT(states, 0) << mode;
+    EXPECT_GT(nominals, 0) << mode;
+    EXPECT_GT(samples, 0) << mode;
+    EXPECT_GT(safe, 0) << mode;
+    // State estimates: the controller and the safety process each refuse
+    // every copy for its values.
+    EXPECT_GE(grew(mode, "controller", "rejected_state_non_finite"), states * 95 / 100) << mode;
+    EXPECT_GE(grew(mode, "safety", "rejected_nonfinite_state"), states * 95 / 100) << mode;
+    // Nominal commands: refused before they can wait for their state.
+    EXPECT_GE(grew(mode, "safety", "rejected_nominal_non_finite"), nominals * 95 / 100) << mode;
+    // Sensor samples: a copy carries its original's utime, which the
+    // estimator has answered: refused as out of order before its values.
+    EXPECT_GE(grew(mode, "estimator", "rejected_non_increasing_time"), samples * 95 / 100) << mode;
+    // Safe commands: the estimator refuses them for their values; the
+    // actuator, with a key, for the MAC the values no longer match.
+    EXPECT_GE(grew(mode, "estimator", "rejected_command_non_finite"), safe * 95 / 100) << mode;
+    EXPECT_GE(grew(mode, "plant_sim", "rejected_command_unauthentic"), safe * 95 / 100) << mode;
+  }
+  // The clock jumps: the other clock's samples are refused and counted by
+  // the estimator (back: out of order; forward: the plant's own samples are
+  // out of order while the jumped clock leads, then the loop returns to the
+  // plant's clock), and no command of the jumped clock moves the platform.
+  std::printf("[bus faults] clock-jump-back: estimator rejected +%lld\n",
+              static_cast<long long>(after_all["clock-jump-back"]["estimator"].rejected_inputs -
+                                     before_all["clock-jump-back"]["estimator"].rejected_inputs));
+  EXPECT_GT(grew("clock-jump-back", "estimator", "rejected_non_increasing_time"), 500);
+  std::printf(
+      "[bus faults] clock-jump-forward: back on the plant's clock %.2f s after the jump ended; "
+      "estimator non_increasing_time +%lld, reinit_time_gap +%lld; plant_sim "
+      "command_future_sample +%lld, command_timeouts +%lld; estimator fault %s\n",
+      jump_recovery_s,
+      static_cast<long long>(
+          grew("clock-jump-forward", "estimator", "rejected_non_increasing_time")),
+      static_cast<long long>(grew("clock-jump-forward", "estimator", "reinit_time_gap")),
+      static_cast<long long>(
+          grew("clock-jump-forward", "plant_sim", "rejected_command_future_sample")),
+      static_cast<long long>(grew("clock-jump-forward", "plant_sim", "command_timeouts")),
+      after_all["clock-jump-forward"]["estimator"].latched_error.c_str());
+  EXPECT_GE(jump_recovery_s, 0.0) << "the loop did not return to the plant's clock";
+  // Back: refused and counted, the estimator never starved. Forward: a
+  // fault, not a silent stall: the estimator starved while the plant's
+  // samples were behind the jumped clock (FAULT, latched) and the supervisor
+  // holds the platform (its estimates restart from the legs, not usable).
+  EXPECT_FALSE(after_all["clock-jump-back"]["estimator"].fault_latched);
+  EXPECT_TRUE(after_all["clock-jump-forward"]["estimator"].fault_latched);
+  EXPECT_GT(grew("clock-jump-forward", "plant_sim", "rejected_command_future_sample"), 0);
+  // Every fault before it left the platform armed.
+  EXPECT_EQ(supervisor_before_jump, int{supervisor_state_t::STATE_ARMED});
+  ASSERT_FALSE(bus.supervisor.empty());
+  EXPECT_EQ(bus.supervisor.back().state, int{supervisor_state_t::STATE_HOLD});
 
   stack.logger.Stop(SIGTERM);
   // The recorder must lose nothing while the bus carries floods, garbage,

@@ -11,6 +11,23 @@
 //       the type's fingerprint flipped, as it was, its utime moved back or
 //       forward by --shift-s (every message of the stack starts with int64
 //       utime, right after the 8-byte fingerprint)
+//   stewart_inject --mode nan|inf ...
+//       each message of the loop heard on the channels (sensor_t, state_t,
+//       setpoint_t, force_command_t, duty_command_t) sent again with every
+//       measured or commanded value a quiet NaN (or +Inf), its fingerprint
+//       and utime those of the original and its seq the original's + 1: a
+//       time every check accepts, values that must be refused. The MAC of a
+//       signed command is left as it was (it no longer verifies: with a key
+//       the copy is refused as unauthentic before its values are read).
+//       Other types (health, supervisor, operator, diagnostics) are not sent:
+//       they carry no value a process acts on.
+//   stewart_inject --mode clock-jump --shift-s S ...
+//       the sensor clock jumps by S (negative: back) and runs on from there:
+//       each sensor_t heard (default channel: the sensors) sent again with
+//       utime and sample_utime moved by S and its own seq, numbered on from
+//       the first heard, for the whole --duration-s. Unlike `future`/`stale`
+//       (single copies, each 10 s off), a sustained second time base, as a
+//       device whose clock jumped would send.
 //
 // Without --channel: every channel of the config. Sends to the config's URL
 // (--lcm-url) with its TTL. Prints one line: what was sent. Exit 0, 2 on a
@@ -19,19 +36,26 @@
 
 #include <CLI/CLI.hpp>
 #include <chrono>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <limits>
 #include <map>
 #include <random>
 #include <string>
 #include <thread>
 #include <vector>
 
+#include "stewart/duty_command_t.hpp"
+#include "stewart/force_command_t.hpp"
 #include "stewart/node/lcm_receiver.h"
 #include "stewart/node/node_main.h"
 #include "stewart/node/raw_bus_sender.h"
 #include "stewart/node/stop_signal.h"
+#include "stewart/sensor_t.hpp"
+#include "stewart/setpoint_t.hpp"
+#include "stewart/state_t.hpp"
 
 namespace stewart {
 namespace {
@@ -43,7 +67,10 @@ enum class Mode {
   kWrongFingerprint,
   kDuplicate,
   kStale,
-  kFuture
+  kFuture,
+  kNan,
+  kInf,
+  kClockJump
 };
 
 const std::map<std::string, Mode> kModes = {
@@ -54,6 +81,9 @@ const std::map<std::string, Mode> kModes = {
     {"duplicate", Mode::kDuplicate},
     {"stale", Mode::kStale},
     {"future", Mode::kFuture},
+    {"nan", Mode::kNan},
+    {"inf", Mode::kInf},
+    {"clock-jump", Mode::kClockJump},
 };
 
 struct Options {
@@ -68,6 +98,87 @@ struct Options {
 
 constexpr int kFingerprintBytes = 8;
 constexpr int kUtimeBytes = 8;
+
+template <typename T, size_t N>
+void Fill(T (&values)[N], T value) {
+  for (T& v : values) v = value;
+}
+
+/// `m` decoded as `Msg` (false: another type or cut), poisoned and encoded
+/// into `out` with seq + 1.
+template <typename Msg, typename Poison>
+bool Poisoned(const uint8_t* data, size_t size, Poison poison, std::vector<uint8_t>* out) {
+  Msg m;
+  if (m.decode(data, 0, static_cast<int>(size)) < 0) return false;
+  m.seq += 1;
+  poison(&m);
+  out->resize(static_cast<size_t>(m.getEncodedSize()));
+  return m.encode(out->data(), 0, static_cast<int>(out->size())) >= 0;
+}
+
+/// The loop's message `data` with every double `value` (quiet NaN or +Inf),
+/// same fingerprint and utime, seq + 1; empty for any other type.
+std::vector<uint8_t> PoisonValues(const uint8_t* data, size_t size, double value) {
+  std::vector<uint8_t> out;
+  if (Poisoned<sensor_t>(
+          data, size,
+          [value](sensor_t* m) {
+            Fill(m->leg_length_m, value);
+            Fill(m->gyro_radps, value);
+            Fill(m->accel_mps2, value);
+            Fill(m->orientation_rpy_rad, value);
+          },
+          &out) ||
+      Poisoned<state_t>(
+          data, size,
+          [value](state_t* m) {
+            Fill(m->q, value);
+            Fill(m->qd, value);
+            Fill(m->q_std, value);
+            Fill(m->qd_std, value);
+            Fill(m->disturbance, value);
+            Fill(m->disturbance_std, value);
+          },
+          &out) ||
+      Poisoned<setpoint_t>(
+          data, size,
+          [value](setpoint_t* m) {
+            Fill(m->q_des, value);
+            Fill(m->qd_des, value);
+            Fill(m->qdd_des, value);
+          },
+          &out) ||
+      Poisoned<force_command_t>(
+          data, size, [value](force_command_t* m) { Fill(m->force_n, value); }, &out) ||
+      Poisoned<duty_command_t>(
+          data, size, [value](duty_command_t* m) { Fill(m->duty, value); }, &out)) {
+    return out;
+  }
+  return {};
+}
+
+/// The sensor clock after the jump: each genuine sample moved by `shift_us`,
+/// numbered on from the first one heard.
+class JumpedClock {
+ public:
+  explicit JumpedClock(int64_t shift_us) : shift_us_(shift_us) {}
+  /// `data` as the jumped device would send it; empty if not a sensor_t.
+  std::vector<uint8_t> Next(const uint8_t* data, size_t size) {
+    sensor_t m;
+    if (m.decode(data, 0, static_cast<int>(size)) < 0) return {};
+    if (next_seq_ < 0) next_seq_ = m.seq;
+    m.utime += shift_us_;
+    m.sample_utime += shift_us_;
+    m.seq = next_seq_++;
+    std::vector<uint8_t> out(static_cast<size_t>(m.getEncodedSize()));
+    m.encode(out.data(), 0, static_cast<int>(out.size()));
+    return out;
+  }
+
+ private:
+  int64_t shift_us_;
+  int64_t next_seq_ = -1;
+};
 
 /// A message heard on the bus, changed as `mode` asks; empty when the
 /// message is too short to carry a fingerprint and a utime.
@@ -96,6 +207,10 @@ std::vector<uint8_t> Mutate(Mode mode, const uint8_t* data, size_t size, double 
       }
       break;
     }
+    case Mode::kNan:
+      return PoisonValues(data, size, std::numeric_limits<double>::quiet_NaN());
+    case Mode::kInf:
+      return PoisonValues(data, size, std::numeric_limits<double>::infinity());
     default:
       break;  // duplicate: as it was
   }
@@ -103,7 +218,14 @@ std::vector<uint8_t> Mutate(Mode mode, const uint8_t* data, size_t size, double 
 }
 
 ExitCode Run(const StackConfig& config, const Options& options) {
+  if (options.shift_s < 0.0 && options.mode != Mode::kClockJump) {
+    spdlog::error("stewart_inject: --shift-s must not be negative for --mode stale|future");
+    return ExitCode::kBadInput;
+  }
   std::vector<std::string> channels = options.channels;
+  if (channels.empty() && options.mode == Mode::kClockJump) {
+    channels.push_back(config.lcm.channels.sensors);
+  }
   if (channels.empty()) {
     for (const ChannelField& field : kChannelFields)
       channels.push_back(config.lcm.channels.*field.member);
@@ -149,14 +271,17 @@ ExitCode Run(const StackConfig& config, const Options& options) {
     std::map<std::string, bool> wanted;
     for (const std::string& c : channels) wanted[c] = true;
     auto next_allowed = start;
+    JumpedClock jumped(static_cast<int64_t>(std::llround(options.shift_s * 1e6)));
     receiver.SubscribeAll([&](const lcm::ReceiveBuffer& rbuf, const std::string& channel) {
       if (!wanted.count(channel)) return;
       const auto now = std::chrono::steady_clock::now();
       if (now < next_allowed) return;
       next_allowed = now + std::chrono::duration_cast<std::chrono::steady_clock::duration>(period);
+      const auto* data = static_cast<const uint8_t*>(rbuf.data);
       const std::vector<uint8_t> payload =
-          Mutate(options.mode, static_cast<const uint8_t*>(rbuf.data), rbuf.data_size,
-                 options.shift_s, &rng);
+          options.mode == Mode::kClockJump
+              ? jumped.Next(data, rbuf.data_size)
+              : Mutate(options.mode, data, rbuf.data_size, options.shift_s, &rng);
       if (payload.empty() && options.mode != Mode::kTruncate) return;
       send(LcmShortDatagram(seqno++, channel, payload));
     });
@@ -190,8 +315,9 @@ int main(int argc, char** argv) {
         app.add_option("--declared-bytes", options->declared_bytes,
                        "fragment-flood: the size each message declares")
             ->check(CLI::Range(1u, 1u << 30));
-        app.add_option("--shift-s", options->shift_s, "stale/future: how far utime moves")
-            ->check(CLI::Range(0.0, 1e9));
+        app.add_option("--shift-s", options->shift_s,
+                       "stale/future: how far utime moves; clock-jump: the jump (negative: back)")
+            ->check(CLI::Range(-1e9, 1e9));
         app.add_option("--seed", options->seed, "random seed (garbage, truncate)");
       },
       nullptr, [options](const StackConfig& config, lcm::LCM*) { return Run(config, *options); });

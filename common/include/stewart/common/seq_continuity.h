@@ -15,7 +15,7 @@ namespace stewart {
 
 enum class SeqEventKind {
   kGap,      ///< seq jumped forward: the log lacks the messages in between
-  kRestart,  ///< seq fell back (or repeated): the publisher started again
+  kRestart,  ///< seq fell back (or repeated with another utime): the publisher started again
 };
 
 const char* ToString(SeqEventKind kind);
@@ -40,6 +40,9 @@ struct SeqStreamStats {
   long missing = 0;
   long gaps = 0;  ///< bursts of missing messages (a restart whose first seqs are missing too)
   long restarts = 0;
+  /// Copies of the message before (same seq and utime): a lockstep resend
+  /// and its answers (common/resend_answer.h), not a restart.
+  long repeats = 0;
   int64_t first_utime = -1;
   int64_t last_utime = -1;
   int64_t first_log_utime = -1;

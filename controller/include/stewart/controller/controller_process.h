@@ -14,6 +14,7 @@
 
 #include "stewart/common/health_counters.h"
 #include "stewart/common/input_time_check.h"
+#include "stewart/common/resend_answer.h"
 #include "stewart/common/signals.h"
 #include "stewart/controller/controller.h"
 
@@ -46,7 +47,11 @@ class ControllerProcess {
                     const Vector6d& home_pose, std::optional<Scenario> scenario,
                     HealthCounters* counters, const TimePlausibilityParams& time = {});
 
-  /// A state estimate arrived: kPublished fills `out`.
+  /// A state estimate arrived: kPublished fills `out`. The state answered
+  /// last, received again (a lockstep resend: an answer was lost
+  /// downstream), is answered again with the same command and setpoint echo,
+  /// without a second control step (common/resend_answer.h; counted
+  /// `resends_answered`).
   ControllerVerdict OnState(const StateSample& state, ControllerProcessOutput* out,
                             std::optional<int64_t> receive_wall_us = std::nullopt);
   /// A live setpoint arrived (only without a scenario).
@@ -62,6 +67,8 @@ class ControllerProcess {
   Controller controller_;
   HealthCounters* counters_;
   InputTimeCheck time_check_;
+  ResendAnswer resend_;
+  ControllerProcessOutput last_answer_;  ///< the answer to the state resend_ holds
   int64_t command_seq_ = 0;
   int64_t setpoint_seq_ = 0;
 };

@@ -22,6 +22,7 @@ using EkfMatrix = Eigen::Matrix<double, kEkfStateSize, kEkfStateSize>;
 /// One sensor sample, as the library sees it (no LCM types here).
 struct SensorSample {
   int64_t utime = 0;  ///< sample time (us): the only clock of the filter
+  int64_t seq = 0;    ///< the sample's number (a resend repeats utime and seq)
   Vector6d leg_length_m = Vector6d::Zero();
   Vector3d gyro_radps = Vector3d::Zero();  ///< {P} axes
   Vector3d accel_mps2 = Vector3d::Zero();  ///< specific force, {P} axes

@@ -9,6 +9,7 @@
 
 #include "stewart/common/health_counters.h"
 #include "stewart/common/input_time_check.h"
+#include "stewart/common/resend_answer.h"
 #include "stewart/common/signals.h"
 #include "stewart/estimator/ekf.h"
 #include "stewart/guard/safe_command_acceptor.h"
@@ -47,7 +48,10 @@ class EstimatorProcess {
   void OnCommand(const ForceCommand& command, std::optional<int64_t> receive_wall_us = std::nullopt,
                  bool authentic = true);
   /// A sensor sample arrived. Returns true when `out` holds an estimate to
-  /// publish.
+  /// publish. The sample last answered, received again (plant_sim's lockstep
+  /// resend: an answer was lost downstream), is answered again with the same
+  /// estimate without a second EKF update (common/resend_answer.h; counted
+  /// `resends_answered`).
   bool OnSensor(const SensorSample& sample, StateSample* out,
                 std::optional<int64_t> receive_wall_us = std::nullopt);
   /// Perfect-state mode: the ground truth, republished as the estimate.
@@ -66,6 +70,8 @@ class EstimatorProcess {
   HealthCounters* counters_;
   InputTimeCheck time_check_;
   std::optional<SafeCommandAcceptor> acceptor_;
+  ResendAnswer resend_;
+  StateSample last_answer_;  ///< the estimate answering the sample resend_ holds
   int64_t seq_ = 0;
 };
 

@@ -19,6 +19,7 @@
 
 #include "stewart/common/health_counters.h"
 #include "stewart/common/input_time_check.h"
+#include "stewart/common/resend_answer.h"
 #include "stewart/common/signals.h"
 #include "stewart/safety/safety_filter.h"
 #include "stewart/safety/supervisor.h"
@@ -55,11 +56,17 @@ class SafetyProcess {
   /// A state estimate arrived. Returns true when `out` holds a command to
   /// publish: the pending nominal command for this state, filtered; or a
   /// fallback (state not usable, or no recent nominal command: the watchdog).
+  /// The state whose sample was answered last, received again (a lockstep
+  /// resend: the answer was lost), is answered again with the same command
+  /// and diagnostics, without a second filter or supervisor step
+  /// (common/resend_answer.h; counted `resends_answered`).
   bool OnState(const StateSample& state, SafetyOutput* out,
                std::optional<int64_t> receive_wall_us = std::nullopt);
 
   /// A nominal command arrived. Returns true when `out` holds a command to
-  /// publish: the filtered command, or a fallback for a stale one.
+  /// publish: the filtered command, or a fallback for a stale one. A
+  /// non-finite one is rejected and counted (`nominal_non_finite`) before it
+  /// can be held for its state and displace the real one.
   bool OnNominal(const ForceCommand& nominal, SafetyOutput* out,
                  std::optional<int64_t> receive_wall_us = std::nullopt);
 
@@ -78,6 +85,13 @@ class SafetyProcess {
   /// kCommandInvalidInput).
   SafetyOutput Fallback(const StateSample& state, int32_t reason);
   const StateSample* FindState(int64_t sample_utime) const;
+  bool HandleState(const StateSample& state, SafetyOutput* out,
+                   std::optional<int64_t> receive_wall_us);
+  bool HandleNominal(const ForceCommand& nominal, SafetyOutput* out,
+                     std::optional<int64_t> receive_wall_us);
+  /// `out` answers the state (`utime`, `seq`): kept for its resend.
+  void Remember(const SafetyOutput& out, int64_t utime, int64_t seq,
+                std::optional<int64_t> receive_wall_us);
   /// The supervisor's step, then its mode applied to `force_n` (the
   /// filtered command or the safe stop) at `state`.
   SafetyOutput Supervise(const StateSample& state, const Vector6d& force_n, int64_t sample_utime,
@@ -113,6 +127,11 @@ class SafetyProcess {
       -1;  ///< first usable state since start or the last unusable one
   int64_t seq_ = 0;
   SafetyDiagnostics diagnostics_{};
+  // The last answer and the state it answers. Its diagnostics pointer stays
+  // valid: diagnostics_ and hold_diagnostics_ change only in a step that
+  // makes a new answer, which replaces it.
+  ResendAnswer resend_;
+  SafetyOutput last_answer_{};
 };
 
 }  // namespace stewart::safety
