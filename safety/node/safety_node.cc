@@ -54,6 +54,13 @@ SafetyNode::SafetyNode(const StackConfig& config, lcm::LCM* lcm,
 }
 
 void SafetyNode::OnState(const lcm::ReceiveBuffer* rbuf, const std::string&, const state_t* msg) {
+  // Stopped (SIGSTOP, a debugger, a starved CPU) and continued, this process
+  // reads a backlog of states while its heartbeat monitor has not yet heard
+  // what came meanwhile: it holds before it answers any of them.
+  if (rbuf->recv_utime > 0) {
+    const std::string stalled = process_.supervisor().InputWaitFault(WallUs() - rbuf->recv_utime);
+    if (!stalled.empty()) Fault(stalled);
+  }
   safety::SafetyOutput out;
   if (process_.OnState(FromMessage(*msg), &out, rbuf->recv_utime)) Publish(out);
 }

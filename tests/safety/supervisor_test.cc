@@ -112,6 +112,24 @@ TEST(Supervisor, AFallbackWhileArmedLatchesHoldUntilResetAndResume) {
   EXPECT_EQ(s.state(), SupervisorState::kArming);
 }
 
+TEST(Supervisor, AStateThatWaitedLongerThanTheLatchIsAStallWhileMoving) {
+  SupervisorConfig c = Config(0.0);
+  c.fallback_latch_s = 0.1;
+  Supervisor s(c);
+  s.OnStep(Good(0));
+  // Not moving: nothing to hold.
+  EXPECT_EQ(s.InputWaitFault(2'000'000), "");
+  ASSERT_TRUE(Do(&s, OperatorCommand::kArm));
+  s.OnStep(Good(1));
+  ASSERT_EQ(s.state(), SupervisorState::kArmed);
+  EXPECT_EQ(s.InputWaitFault(100'000), "");
+  const std::string stalled = s.InputWaitFault(100'001);
+  EXPECT_NE(stalled.find("stalled"), std::string::npos) << stalled;
+  s.OnFault(stalled);
+  EXPECT_EQ(s.state(), SupervisorState::kHold);
+  EXPECT_EQ(s.InputWaitFault(2'000'000), "");
+}
+
 TEST(Supervisor, ShortFallbacksGoOnLastingOnesLatch) {
   SupervisorConfig c = Config(0.0);
   c.fallback_latch_s = 0.05;

@@ -13,6 +13,11 @@
 // CPUs to the control loop. Each event keeps the kernel's arrival time of its
 // datagram (SO_TIMESTAMP), not the time of the batch. It drains the socket
 // before it exits and reports what it wrote.
+//
+// A restarted logger continues its log with --append, so that the log's check
+// (stewart_log_export --check) names what was lost while none ran, as gaps
+// in every stream, instead of a second file starting without them or -f
+// overwriting the first.
 #include <spdlog/spdlog.h>
 
 #include <CLI/CLI.hpp>
@@ -70,6 +75,17 @@ class Recorder {
   int64_t failed_ = 0;
 };
 
+/// The length of `path` up to the end of its last complete event: a logger
+/// killed mid-write leaves a cut event, after which LCM's reader stops, so
+/// an appended log must start where the complete ones end.
+long CompleteLength(const std::string& path) {
+  lcm::LogFile log(path, "r");
+  if (!log.good()) return -1;
+  long end = 0;
+  while (log.readNextEvent() != nullptr) end = std::ftell(log.getFilePtr());
+  return end;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -78,6 +94,7 @@ int main(int argc, char** argv) {
   double flush_s = 0.0;
   int batch_ms = 2;
   bool force = false;
+  bool append = false;
   app.add_option("--lcm-url", url, "LCM URL (udpm://; default: LCM's default)");
   app.add_option("-c,--channel", channels, "channel regex (the whole name must match)")
       ->capture_default_str();
@@ -88,12 +105,35 @@ int main(int argc, char** argv) {
                  "not hold a real-time task behind)")
       ->capture_default_str();
   app.add_flag("-f,--force", force, "overwrite FILE");
+  app.add_flag("-a,--append", append,
+               "continue FILE if it exists (a restarted logger): the time it did not run shows "
+               "as gaps in stewart_log_export --check")
+      ->excludes("--force");
   app.add_option("file", file, "log file")->required();
   CLI11_PARSE(app, argc, argv);
 
-  if (!force && std::filesystem::exists(file)) {
-    spdlog::error("stewart_logger: {} exists (use -f to overwrite)", file);
+  const bool exists = std::filesystem::exists(file);
+  if (!force && !append && exists) {
+    spdlog::error("stewart_logger: {} exists (use -f to overwrite, -a to continue it)", file);
     return 2;
+  }
+  if (append && exists) {
+    const long complete = CompleteLength(file);
+    std::error_code error;
+    const auto size = std::filesystem::file_size(file, error);
+    if (complete < 0 || error) {
+      spdlog::error("stewart_logger: cannot read {} to continue it", file);
+      return 2;
+    }
+    if (static_cast<std::uintmax_t>(complete) < size) {
+      spdlog::warn("stewart_logger: {}: {} bytes of a cut last event dropped before continuing",
+                   file, size - static_cast<std::uintmax_t>(complete));
+      std::filesystem::resize_file(file, static_cast<std::uintmax_t>(complete), error);
+      if (error) {
+        spdlog::error("stewart_logger: cannot cut {}: {}", file, error.message());
+        return 2;
+      }
+    }
   }
   std::regex channel_regex;
   try {
@@ -109,7 +149,7 @@ int main(int argc, char** argv) {
     spdlog::error("stewart_logger: {}", e.what());
     return 1;
   }
-  lcm::LogFile log(file, "w");
+  lcm::LogFile log(file, append ? "a" : "w");
   if (!log.good()) {
     spdlog::error("stewart_logger: cannot write {}", file);
     return 2;
@@ -119,7 +159,8 @@ int main(int argc, char** argv) {
     recorder.OnMessage(rbuf, channel);
   });
   stewart::InstallStopSignalHandlers();
-  spdlog::info("stewart_logger: {} -> {}", url.empty() ? "default URL" : url, file);
+  spdlog::info("stewart_logger: {} -> {}{}", url.empty() ? "default URL" : url, file,
+               append && exists ? " (continued)" : "");
   const auto flush_every = std::chrono::duration<double>(flush_s);
   auto last_flush = std::chrono::steady_clock::now();
   while (!stewart::StopRequested()) {

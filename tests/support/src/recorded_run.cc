@@ -43,12 +43,38 @@ const Bound* RecordedRun::Worst() const {
   return worst;
 }
 
+void AddTruthSample(const state_t& state, RecordedRun* run) {
+  RecordedRun& s = *run;
+  bool finite = true;
+  for (int i = 0; i < 6; ++i) {
+    finite = finite && std::isfinite(state.q[i]) && std::isfinite(state.qd[i]);
+  }
+  if (!finite) {
+    ++s.truth_non_finite;
+    return;
+  }
+  if (s.truth_samples == 0) s.first_truth = state;
+  const double t_s = static_cast<double>(state.utime - s.first_truth.utime) * 1e-6;
+  s.truth_span_s = t_s;
+  ++s.truth_samples;
+  s.max_x = std::max(s.max_x, state.q[0]);
+  s.max_xd = std::max(s.max_xd, state.qd[0]);
+  for (Bound& b : s.bounds) {
+    const double value = b.velocity ? state.qd[b.axis] : state.q[b.axis];
+    const double excess = b.sign * (value - b.bound);
+    if (excess > b.max_excess) {
+      b.max_excess = excess;
+      b.at_s = t_s;
+      b.value_at_max = value;
+    }
+  }
+}
+
 RecordedRun ReadRecordedRun(const std::string& log_path, const StackConfig& config) {
   RecordedRun s;
   s.bounds = BoundsOf(config.safety);
   lcm::LogFile log(log_path, "r");
   if (!log.good()) return s;
-  int64_t first_utime = -1;
   while (const lcm::LogEvent* event = log.readNextEvent()) {
     const bool truth_channel = event->channel == config.lcm.channels.state_truth;
     const bool estimate_channel = event->channel == config.lcm.channels.state_estimate;
@@ -68,30 +94,7 @@ RecordedRun ReadRecordedRun(const std::string& log_path, const StackConfig& conf
       ++s.truth_undecodable;
       continue;
     }
-    bool finite = true;
-    for (int i = 0; i < 6; ++i) {
-      finite = finite && std::isfinite(state.q[i]) && std::isfinite(state.qd[i]);
-    }
-    if (!finite) {
-      ++s.truth_non_finite;
-      continue;
-    }
-    if (first_utime < 0) first_utime = state.utime;
-    const double t_s = static_cast<double>(state.utime - first_utime) * 1e-6;
-    if (s.truth_samples == 0) s.first_truth = state;
-    s.truth_span_s = t_s;
-    ++s.truth_samples;
-    s.max_x = std::max(s.max_x, state.q[0]);
-    s.max_xd = std::max(s.max_xd, state.qd[0]);
-    for (Bound& b : s.bounds) {
-      const double value = b.velocity ? state.qd[b.axis] : state.q[b.axis];
-      const double excess = b.sign * (value - b.bound);
-      if (excess > b.max_excess) {
-        b.max_excess = excess;
-        b.at_s = t_s;
-        b.value_at_max = value;
-      }
-    }
+    AddTruthSample(state, &s);
   }
   return s;
 }

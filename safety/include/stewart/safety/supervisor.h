@@ -136,6 +136,14 @@ class Supervisor {
   /// ARMED; remembered as the unacknowledged fault in any state.
   void OnFault(const std::string& reason);
 
+  /// The fault of a safety process that did not run: the state it reads now
+  /// arrived `waited_us` (wall time) ago. While ARMING or ARMED a wait
+  /// beyond fallback_latch_s is one (the actuators got no command from it
+  /// for that long, as when fallbacks last that long), else none: "" when
+  /// none, its reason for OnFault otherwise. Checked before the state is
+  /// answered, so a process stopped and continued answers its backlog held.
+  std::string InputWaitFault(int64_t waited_us) const;
+
   SupervisorState state() const { return state_; }
   const std::string& reason() const { return reason_; }
   /// A fault not yet acknowledged by a reset.

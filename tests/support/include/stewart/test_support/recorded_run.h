@@ -53,6 +53,11 @@ struct RecordedRun {
 /// `config.safety`. An unreadable log reads as an empty run.
 RecordedRun ReadRecordedRun(const std::string& log_path, const StackConfig& config);
 
+/// Adds one ground truth sample to `run` (its bounds set, e.g. BoundsOf the
+/// config): a test that hears the truth on the bus checks it as it comes.
+/// A non-finite sample is counted, not checked.
+void AddTruthSample(const state_t& state, RecordedRun* run);
+
 /// "N truth samples over S s, max x, max xd, max excess (the worst bound)",
 /// for a test's log line; `run` must have bounds.
 std::string Describe(const RecordedRun& run);
