@@ -32,6 +32,7 @@
 #include "stewart/node/lcm_receiver.h"
 #include "stewart/state_t.hpp"
 #include "stewart/test_support/child_process.h"
+#include "stewart/test_support/health_counter.h"
 #include "stewart/test_support/recorded_run.h"
 #include "stewart/test_support/stack_launch.h"
 
@@ -40,15 +41,6 @@ namespace {
 
 constexpr int kPort = 7922;
 constexpr double kDurationS = 8.0;
-
-int64_t Counter(const health_t& h, const std::string& name) {
-  for (int i = 0; i < h.num_counters; ++i) {
-    if (h.counter_names[static_cast<size_t>(i)] == name) {
-      return h.counter_values[static_cast<size_t>(i)];
-    }
-  }
-  return 0;
-}
 
 struct Bus {
   void OnState(const lcm::ReceiveBuffer*, const std::string&, const state_t* m) { last_state = *m; }
@@ -151,7 +143,7 @@ TEST_P(ForgedNominalStack, MillionNewtonNominalsForTheNextSample) {
   }
   if (bound) {
     EXPECT_GE(answered_forgeries, 50) << "of " << forged_samples.size() << " forgeries";
-    EXPECT_GE(Counter(bus.health["safety"], "nominal_bounded"), answered_forgeries);
+    EXPECT_GE(test::HealthCounter(bus.health["safety"], "nominal_bounded"), answered_forgeries);
   } else {
     EXPECT_EQ(answered_forgeries, 0);
   }
@@ -162,7 +154,7 @@ TEST_P(ForgedNominalStack, MillionNewtonNominalsForTheNextSample) {
   std::printf("[forged nominal] %zu forgeries, %d answered bounded; %s\n", forged_samples.size(),
               answered_forgeries, test::Describe(run).c_str());
   EXPECT_GE(static_cast<double>(run.truth_samples), 0.9 * kDurationS * config.sensors.rate_hz);
-  const int64_t guard_trips = Counter(bus.health["plant_sim"], "guard_trips");
+  const int64_t guard_trips = test::HealthCounter(bus.health["plant_sim"], "guard_trips");
   ASSERT_TRUE(bus.health.count("plant_sim"));
   if (bound) {
     // The forgeries change nothing the filter would not allow: every limit

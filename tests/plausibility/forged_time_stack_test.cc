@@ -39,6 +39,7 @@
 #include "stewart/sensor_t.hpp"
 #include "stewart/state_t.hpp"
 #include "stewart/test_support/child_process.h"
+#include "stewart/test_support/health_counter.h"
 #include "stewart/test_support/recorded_run.h"
 #include "stewart/test_support/stack_launch.h"
 
@@ -49,15 +50,6 @@ constexpr int kPort = 7920;
 constexpr double kDurationS = 6.0;
 constexpr int64_t kForgedUtime = 8'000'000'000'000'000'000;
 constexpr int64_t kAheadUs = 1'000'000'000'000;
-
-int64_t Counter(const health_t& h, const std::string& name) {
-  for (int i = 0; i < h.num_counters; ++i) {
-    if (h.counter_names[static_cast<size_t>(i)] == name) {
-      return h.counter_values[static_cast<size_t>(i)];
-    }
-  }
-  return 0;
-}
 
 /// What the test sees of the bus.
 struct Bus {
@@ -173,16 +165,16 @@ TEST(ForgedTimeStack, LockstepRunSurvivesForgedTimesAndTheWatchdogStillFires) {
   const health_t& estimator_health = bus.health["estimator"];
   const health_t& controller_health = bus.health["controller"];
   const health_t& safety_health = bus.health["safety"];
-  EXPECT_EQ(Counter(estimator_health, "rejected_sensor_time_implausible"), 1);
-  EXPECT_EQ(Counter(estimator_health, "rejected_command_time_implausible"), 0);
-  EXPECT_EQ(Counter(estimator_health, "rejected_non_increasing_time"), 0);
-  EXPECT_EQ(Counter(controller_health, "rejected_state_time_implausible"), 1);
-  EXPECT_EQ(Counter(controller_health, "rejected_state_time_not_increasing"), 0);
-  EXPECT_EQ(Counter(safety_health, "rejected_state_time_implausible"), 1);
-  EXPECT_EQ(Counter(safety_health, "rejected_nominal_time_implausible"), 1);
-  EXPECT_EQ(Counter(safety_health, "rejected_state_time_not_increasing"), 0);
+  EXPECT_EQ(test::HealthCounter(estimator_health, "rejected_sensor_time_implausible"), 1);
+  EXPECT_EQ(test::HealthCounter(estimator_health, "rejected_command_time_implausible"), 0);
+  EXPECT_EQ(test::HealthCounter(estimator_health, "rejected_non_increasing_time"), 0);
+  EXPECT_EQ(test::HealthCounter(controller_health, "rejected_state_time_implausible"), 1);
+  EXPECT_EQ(test::HealthCounter(controller_health, "rejected_state_time_not_increasing"), 0);
+  EXPECT_EQ(test::HealthCounter(safety_health, "rejected_state_time_implausible"), 1);
+  EXPECT_EQ(test::HealthCounter(safety_health, "rejected_nominal_time_implausible"), 1);
+  EXPECT_EQ(test::HealthCounter(safety_health, "rejected_state_time_not_increasing"), 0);
   for (const auto& [name, h] : bus.health) {
-    EXPECT_GE(h.rejected_inputs, Counter(h, "rejected_state_time_implausible")) << name;
+    EXPECT_GE(h.rejected_inputs, test::HealthCounter(h, "rejected_state_time_implausible")) << name;
   }
   for (const auto& [name, error] : bus.latched) {
     ADD_FAILURE() << name << " latched a fault: " << error;

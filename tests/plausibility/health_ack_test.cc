@@ -22,6 +22,7 @@
 #include "stewart/operator_command_t.hpp"
 #include "stewart/state_t.hpp"
 #include "stewart/test_support/child_process.h"
+#include "stewart/test_support/health_counter.h"
 #include "stewart/test_support/lcm_messages.h"
 
 namespace stewart {
@@ -33,15 +34,6 @@ int64_t WallUtime() {
   return std::chrono::duration_cast<std::chrono::microseconds>(
              std::chrono::system_clock::now().time_since_epoch())
       .count();
-}
-
-int64_t Counter(const health_t& h, const std::string& name) {
-  for (int i = 0; i < h.num_counters; ++i) {
-    if (h.counter_names[static_cast<size_t>(i)] == name) {
-      return h.counter_values[static_cast<size_t>(i)];
-    }
-  }
-  return 0;
 }
 
 struct Heartbeats {
@@ -135,7 +127,7 @@ TEST_F(HealthAck, RejectingEveryStateLatchesAFaultUntilASignedReset) {
   ASSERT_TRUE(wait_for_beat(
       [](const health_t& h) {
         return h.fault_latched && h.worst_state == health_t::STATE_FAULT &&
-               Counter(h, "rejected_state_time_implausible") >= 50;
+               test::HealthCounter(h, "rejected_state_time_implausible") >= 50;
       },
       "with a latched FAULT and the implausible states counted"));
 
@@ -156,9 +148,9 @@ TEST_F(HealthAck, RejectingEveryStateLatchesAFaultUntilASignedReset) {
   other_key[0] ^= 1;
   MessageAuthenticator(other_key).Sign(&reset);
   lcm->publish(config.lcm.channels.operator_command, &reset);
-  ASSERT_TRUE(
-      wait_for_beat([](const health_t& h) { return Counter(h, "operator_resets_rejected") == 1; },
-                    "counting the unverified RESET"));
+  ASSERT_TRUE(wait_for_beat(
+      [](const health_t& h) { return test::HealthCounter(h, "operator_resets_rejected") == 1; },
+      "counting the unverified RESET"));
   EXPECT_TRUE(beats.received.back().fault_latched);
 
   // The operator's RESET: acknowledged at the next heartbeat.
@@ -167,7 +159,9 @@ TEST_F(HealthAck, RejectingEveryStateLatchesAFaultUntilASignedReset) {
   MessageAuthenticator(key_).Sign(&reset);
   lcm->publish(config.lcm.channels.operator_command, &reset);
   ASSERT_TRUE(wait_for_beat(
-      [](const health_t& h) { return !h.fault_latched && Counter(h, "operator_resets") == 1; },
+      [](const health_t& h) {
+        return !h.fault_latched && test::HealthCounter(h, "operator_resets") == 1;
+      },
       "with the fault acknowledged"));
   EXPECT_EQ(beats.received.back().latched_error, "");
   EXPECT_TRUE(controller.running());

@@ -130,6 +130,19 @@ TEST(Supervisor, AStateThatWaitedLongerThanTheLatchIsAStallWhileMoving) {
   EXPECT_EQ(s.InputWaitFault(2'000'000), "");
 }
 
+TEST(Supervisor, ALatchOfZeroDoesNotMakeEveryWaitAStall) {
+  SupervisorConfig c = Config(0.0);
+  c.fallback_latch_s = 0.0;  // every lasting fallback latches at once
+  Supervisor s(c);
+  s.OnStep(Good(0));
+  ASSERT_TRUE(Do(&s, OperatorCommand::kArm));
+  s.OnStep(Good(1));
+  ASSERT_EQ(s.state(), SupervisorState::kArmed);
+  EXPECT_EQ(s.InputWaitFault(50), "") << "a scheduling delay of 50 us";
+  EXPECT_EQ(s.InputWaitFault(100'000), "");
+  EXPECT_NE(s.InputWaitFault(100'001).find("stalled"), std::string::npos);
+}
+
 TEST(Supervisor, ShortFallbacksGoOnLastingOnesLatch) {
   SupervisorConfig c = Config(0.0);
   c.fallback_latch_s = 0.05;

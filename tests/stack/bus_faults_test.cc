@@ -46,6 +46,7 @@
 #include "stewart/state_t.hpp"
 #include "stewart/supervisor_state_t.hpp"
 #include "stewart/test_support/child_process.h"
+#include "stewart/test_support/health_counter.h"
 #include "stewart/test_support/recorded_run.h"
 #include "stewart/test_support/stack_launch.h"
 
@@ -53,15 +54,6 @@ namespace stewart {
 namespace {
 
 constexpr int kPort = 8010;
-
-int64_t Counter(const health_t& h, const std::string& name) {
-  for (int i = 0; i < h.num_counters; ++i) {
-    if (h.counter_names[static_cast<size_t>(i)] == name) {
-      return h.counter_values[static_cast<size_t>(i)];
-    }
-  }
-  return 0;
-}
 
 template <typename T, size_t N>
 bool Finite(const T (&values)[N]) {
@@ -351,9 +343,12 @@ TEST(BusFaults, HostileTrafficOnEveryChannelIsCountedAndChangesNothingUnsafe) {
     std::printf(
         "[bus faults] %-17s safety: rx_bad +%lld, rx_decode_fail +%lld, rx_incomplete +%lld, "
         "rejected +%lld\n",
-        mode.c_str(), static_cast<long long>(Counter(h, "rx_bad") - Counter(b, "rx_bad")),
-        static_cast<long long>(Counter(h, "rx_decode_fail") - Counter(b, "rx_decode_fail")),
-        static_cast<long long>(Counter(h, "rx_incomplete") - Counter(b, "rx_incomplete")),
+        mode.c_str(),
+        static_cast<long long>(test::HealthCounter(h, "rx_bad") - test::HealthCounter(b, "rx_bad")),
+        static_cast<long long>(test::HealthCounter(h, "rx_decode_fail") -
+                               test::HealthCounter(b, "rx_decode_fail")),
+        static_cast<long long>(test::HealthCounter(h, "rx_incomplete") -
+                               test::HealthCounter(b, "rx_incomplete")),
         static_cast<long long>(h.rejected_inputs - b.rejected_inputs));
   }
   for (const supervisor_state_t& s : bus.supervisor) {
@@ -372,7 +367,7 @@ TEST(BusFaults, HostileTrafficOnEveryChannelIsCountedAndChangesNothingUnsafe) {
   // Each fault counted where it landed: the safety process subscribes to
   // STATE_EST, CMD_NOMINAL, SETPOINT, HEALTH and OPERATOR.
   const auto delta = [&](const std::string& mode, const std::string& counter) {
-    return Counter(after[mode], counter) - Counter(before[mode], counter);
+    return test::HealthCounter(after[mode], counter) - test::HealthCounter(before[mode], counter);
   };
   const auto rejected = [&](const std::string& mode) {
     return after[mode].rejected_inputs - before[mode].rejected_inputs;
@@ -397,7 +392,8 @@ TEST(BusFaults, HostileTrafficOnEveryChannelIsCountedAndChangesNothingUnsafe) {
   // (a process or the test may miss a datagram of a flood; printed).
   const auto grew = [&](const std::string& mode, const std::string& process,
                         const std::string& counter) {
-    return Counter(after_all[mode][process], counter) - Counter(before_all[mode][process], counter);
+    return test::HealthCounter(after_all[mode][process], counter) -
+           test::HealthCounter(before_all[mode][process], counter);
   };
   const auto heard = [&](const std::string& mode, const std::string& channel) {
     return injected_after[mode][channel] - injected_before[mode][channel];

@@ -32,6 +32,7 @@
 #include "stewart/state_t.hpp"
 #include "stewart/supervisor_state_t.hpp"
 #include "stewart/test_support/child_process.h"
+#include "stewart/test_support/health_counter.h"
 #include "stewart/test_support/stack_launch.h"
 
 namespace stewart {
@@ -50,15 +51,6 @@ struct Received {
   Msg msg;
   int64_t recv_us;  // wall time the test received it (LCM's receive time)
 };
-
-int64_t Counter(const health_t& h, const std::string& name) {
-  for (int i = 0; i < h.num_counters; ++i) {
-    if (h.counter_names[static_cast<size_t>(i)] == name) {
-      return h.counter_values[static_cast<size_t>(i)];
-    }
-  }
-  return 0;
-}
 
 bool Fallback(const force_command_t& c) { return (c.flags & force_command_t::FLAG_FALLBACK) != 0; }
 
@@ -519,10 +511,10 @@ TEST(FaultToHold, ControllerSilent) {
   const int64_t fault = WallUs();
   const Received<health_t>* safety_before = LastBeat(stack.bus, "safety", fault);
   ASSERT_NE(safety_before, nullptr);
-  const int64_t faults_before = Counter(safety_before->msg, "supervisor_faults");
+  const int64_t faults_before = test::HealthCounter(safety_before->msg, "supervisor_faults");
   stack.controller->Signal(SIGSTOP);
   const auto counted = [&](const health_t& h) {
-    return Counter(h, "supervisor_faults") > faults_before;
+    return test::HealthCounter(h, "supervisor_faults") > faults_before;
   };
   stack.PumpUntil(
       [&] {

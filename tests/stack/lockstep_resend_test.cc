@@ -28,6 +28,7 @@
 #include "stewart/node/lcm_handle.h"
 #include "stewart/node/lcm_receiver.h"
 #include "stewart/test_support/child_process.h"
+#include "stewart/test_support/health_counter.h"
 #include "stewart/test_support/stack_launch.h"
 
 namespace stewart {
@@ -37,15 +38,6 @@ constexpr int kFirstPort = 8030;
 /// 1000 ticks at 1 kHz; the loss at seq 300 (the stack armed by then).
 constexpr double kDurationS = 1.0;
 constexpr int64_t kLostSeq = 300;
-
-int64_t Counter(const health_t& h, const std::string& name) {
-  for (int i = 0; i < h.num_counters; ++i) {
-    if (h.counter_names[static_cast<size_t>(i)] == name) {
-      return h.counter_values[static_cast<size_t>(i)];
-    }
-  }
-  return 0;
-}
 
 struct LockstepResult {
   int plant_exit = -1;
@@ -122,10 +114,10 @@ LockstepResult LockstepRun(const std::string& folder, int port, const std::strin
       "[lockstep resend] lose %s: plant_sim exit %d after %.2f s, %zu truth samples, "
       "lockstep_resends %lld, resends_answered estimator %lld controller %lld safety %lld\n",
       lose.empty() ? "nothing" : lose.c_str(), run.plant_exit, run.wall_s, run.truth.size(),
-      static_cast<long long>(Counter(run.health["plant_sim"], "lockstep_resends")),
-      static_cast<long long>(Counter(run.health["estimator"], "resends_answered")),
-      static_cast<long long>(Counter(run.health["controller"], "resends_answered")),
-      static_cast<long long>(Counter(run.health["safety"], "resends_answered")));
+      static_cast<long long>(test::HealthCounter(run.health["plant_sim"], "lockstep_resends")),
+      static_cast<long long>(test::HealthCounter(run.health["estimator"], "resends_answered")),
+      static_cast<long long>(test::HealthCounter(run.health["controller"], "resends_answered")),
+      static_cast<long long>(test::HealthCounter(run.health["safety"], "resends_answered")));
   std::fflush(stdout);
   return run;
 }
@@ -141,15 +133,15 @@ TEST_F(LockstepResend, ALostMessageIsAnsweredAgainAndTheRunIsTheSameAsWithoutThe
   ASSERT_EQ(reference.plant_exit, 0);
   const auto ticks = static_cast<size_t>(kDurationS * 1000.0) + 1;
   ASSERT_EQ(reference.truth.size(), ticks);
-  EXPECT_EQ(Counter(reference.health["plant_sim"], "lockstep_resends"), 0);
+  EXPECT_EQ(test::HealthCounter(reference.health["plant_sim"], "lockstep_resends"), 0);
 
   // The estimate of one sample lost (to the controller, the safety process
   // and the logger alike): the plant resends the sample, the estimator
   // answers it again with that estimate, without a second EKF update.
   LockstepResult lost_state = LockstepRun(run_folder_, kFirstPort + 1, "estimator");
   EXPECT_EQ(lost_state.plant_exit, 0) << "the loop stalled on the lost estimate";
-  EXPECT_GE(Counter(lost_state.health["plant_sim"], "lockstep_resends"), 1);
-  EXPECT_GE(Counter(lost_state.health["estimator"], "resends_answered"), 1);
+  EXPECT_GE(test::HealthCounter(lost_state.health["plant_sim"], "lockstep_resends"), 1);
+  EXPECT_GE(test::HealthCounter(lost_state.health["estimator"], "resends_answered"), 1);
   EXPECT_TRUE(lost_state.truth == reference.truth)
       << "the ground truth differs from the run without the loss";
 
@@ -158,9 +150,9 @@ TEST_F(LockstepResend, ALostMessageIsAnsweredAgainAndTheRunIsTheSameAsWithoutThe
   // answer the copy of the input they answered with the same output.
   LockstepResult lost_command = LockstepRun(run_folder_, kFirstPort + 2, "safety");
   EXPECT_EQ(lost_command.plant_exit, 0) << "the loop stalled on the lost command";
-  EXPECT_GE(Counter(lost_command.health["plant_sim"], "lockstep_resends"), 1);
+  EXPECT_GE(test::HealthCounter(lost_command.health["plant_sim"], "lockstep_resends"), 1);
   for (const char* name : {"estimator", "controller", "safety"}) {
-    EXPECT_GE(Counter(lost_command.health[name], "resends_answered"), 1) << name;
+    EXPECT_GE(test::HealthCounter(lost_command.health[name], "resends_answered"), 1) << name;
   }
   EXPECT_TRUE(lost_command.truth == reference.truth)
       << "the ground truth differs from the run without the loss";

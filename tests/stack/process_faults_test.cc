@@ -54,6 +54,7 @@
 #include "stewart/state_t.hpp"
 #include "stewart/supervisor_state_t.hpp"
 #include "stewart/test_support/child_process.h"
+#include "stewart/test_support/health_counter.h"
 #include "stewart/test_support/recorded_run.h"
 #include "stewart/test_support/stack_launch.h"
 
@@ -70,15 +71,6 @@ int64_t WallUs() {
   return std::chrono::duration_cast<std::chrono::microseconds>(
              std::chrono::system_clock::now().time_since_epoch())
       .count();
-}
-
-int64_t Counter(const health_t& h, const std::string& name) {
-  for (int i = 0; i < h.num_counters; ++i) {
-    if (h.counter_names[static_cast<size_t>(i)] == name) {
-      return h.counter_values[static_cast<size_t>(i)];
-    }
-  }
-  return 0;
 }
 
 bool Fallback(const force_command_t& c) { return (c.flags & force_command_t::FLAG_FALLBACK) != 0; }
@@ -380,9 +372,9 @@ struct CounterDelta {
     const auto b = before.find(name), a = after.find(name);
     if (a == after.end()) return 0;
     const int64_t base = b != before.end() && a->second.messages_in >= b->second.messages_in
-                             ? Counter(b->second, counter)
+                             ? test::HealthCounter(b->second, counter)
                              : 0;
-    return Counter(a->second, counter) - base;
+    return test::HealthCounter(a->second, counter) - base;
   }
 };
 

@@ -142,7 +142,11 @@ class Supervisor {
   /// for that long, as when fallbacks last that long), else none: "" when
   /// none, its reason for OnFault otherwise. Checked before the state is
   /// answered, so a process stopped and continued answers its backlog held.
+  /// The wait allowed is never below kMinInputWait_s: fallback_latch_s 0
+  /// (latch every fallback at once) must not make a scheduling delay of a
+  /// few microseconds a fault.
   std::string InputWaitFault(int64_t waited_us) const;
+  static constexpr double kMinInputWait_s = 0.1;
 
   SupervisorState state() const { return state_; }
   const std::string& reason() const { return reason_; }
