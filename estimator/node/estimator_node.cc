@@ -42,7 +42,10 @@ void EstimatorNode::OnSupervisor(const lcm::ReceiveBuffer* rbuf, const std::stri
 
 void EstimatorNode::OnCommand(const lcm::ReceiveBuffer* rbuf, const std::string&,
                               const force_command_t* msg) {
-  process_.OnCommand(FromMessage(*msg), rbuf->recv_utime, auth_.Verify(*msg));
+  StateSample state;
+  if (process_.OnCommand(FromMessage(*msg), &state, rbuf->recv_utime, auth_.Verify(*msg))) {
+    Publish(state);
+  }
 }
 
 void EstimatorNode::OnSensor(const lcm::ReceiveBuffer* rbuf, const std::string&,
@@ -65,6 +68,18 @@ void EstimatorNode::Publish(const StateSample& state) {
   lcm_->publish(config_.lcm.channels.state_estimate, &state_msg_);
 }
 
-ExitCode EstimatorNode::Run() { return RunNodeLoop("estimator", lcm_, &receiver_, &health_, 100); }
+ExitCode EstimatorNode::Run() {
+  // A sample waiting for its answer (EstimatorProcess::OnSensor) is checked
+  // every few ms, on the receive clock (SO_TIMESTAMP: the wall clock).
+  // What the socket holds is read first: a process that was not scheduled
+  // for a while may have its answer queued already.
+  return RunNodeLoop("estimator", lcm_, &receiver_, &health_, 5, [this] {
+    if (!process_.waiting()) return false;
+    receiver_.HandleTimeout(0);
+    StateSample state;
+    if (process_.FlushWaiting(ReceiveClockUs(), &state)) Publish(state);
+    return false;
+  });
+}
 
 }  // namespace stewart

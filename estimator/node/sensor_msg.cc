@@ -14,6 +14,7 @@ SensorSample SampleFromMessage(const sensor_t& msg) {
   CopyFields(fields(msg), fields(s));
   s.legs_valid = (msg.status & sensor_t::STATUS_LEG_FAULT) == 0;
   s.imu_valid = (msg.status & sensor_t::STATUS_IMU_FAULT) == 0;
+  s.previous_answer_applied = (msg.status & sensor_t::STATUS_ANSWER_APPLIED) != 0;
   return s;
 }
 

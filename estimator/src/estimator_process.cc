@@ -2,6 +2,8 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
+#include <cmath>
 #include <tuple>
 
 #include "stewart/common/check.h"
@@ -42,27 +44,30 @@ AnnouncementVerdict EstimatorProcess::OnAnnouncement(const SessionAnnouncement& 
   return verdict;
 }
 
-void EstimatorProcess::OnCommand(const ForceCommand& command,
+bool EstimatorProcess::OnCommand(const ForceCommand& command, StateSample* out,
                                  std::optional<int64_t> receive_wall_us, bool authentic) {
   counters_->CountIn();
   // A command's sample_utime is the sample it answers: the EKF files it
   // under that time, so a far-off one would act on every later prediction.
   if (!time_check_.CheckOther("command", command.utime, command.sample_utime, receive_wall_us)) {
-    return;
+    return false;
   }
+  // The answer has come, whatever the verdict below: a sample waiting for
+  // it waits no longer (an answer the actuators refuse is not what they
+  // applied either).
+  newest_answer_utime_ = std::max(newest_answer_utime_, command.sample_utime);
   if (!command.force_n.allFinite()) {
     counters_->Reject("command_non_finite");
-    return;
+  } else if (const CommandRejection rejection =
+                 acceptor_ ? acceptor_->Check(command, authentic) : CommandRejection::kNone;
+             rejection != CommandRejection::kNone) {
+    counters_->Reject(ToString(rejection));
+  } else {
+    ekf_.SetForceCommand(command.sample_utime, command.force_n,
+                         (command.flags & kCommandDriveOff) != 0);
   }
-  if (acceptor_) {
-    const CommandRejection rejection = acceptor_->Check(command, authentic);
-    if (rejection != CommandRejection::kNone) {
-      counters_->Reject(ToString(rejection));
-      return;
-    }
-  }
-  ekf_.SetForceCommand(command.sample_utime, command.force_n,
-                       (command.flags & kCommandDriveOff) != 0);
+  if (waiting_ && newest_answer_utime_ >= waiting_->answer_utime) return ReleaseWaiting(out);
+  return false;
 }
 
 bool EstimatorProcess::OnSensor(const SensorSample& sample, StateSample* out,
@@ -79,6 +84,39 @@ bool EstimatorProcess::OnSensor(const SensorSample& sample, StateSample* out,
     *out = last_answer_;
     return true;
   }
+  if (waiting_) {
+    if (sample.utime == waiting_->sample.utime) return false;  // resent: it still waits
+    // A newer sample: the waiting one's answer did not come. It updates the
+    // EKF; the newer one's estimate supersedes its own.
+    counters_->Count("answer_not_heard");
+    StateSample superseded;
+    ReleaseWaiting(&superseded);
+  }
+  if (sample.previous_answer_applied && last_sample_utime_ >= 0 &&
+      sample.utime > last_sample_utime_ && newest_answer_utime_ < last_sample_utime_) {
+    waiting_ = WaitingSample{sample, receive_wall_us, last_sample_utime_};
+    counters_->Count("samples_waited_for_answer");
+    return false;
+  }
+  return Update(sample, out, receive_wall_us);
+}
+
+bool EstimatorProcess::FlushWaiting(int64_t wall_us, StateSample* out) {
+  if (!waiting_ || !waiting_->receive_wall_us) return false;
+  if (wall_us - *waiting_->receive_wall_us < std::llround(kAnswerWait_s * 1e6)) return false;
+  counters_->Count("answer_not_heard");
+  return ReleaseWaiting(out);
+}
+
+bool EstimatorProcess::ReleaseWaiting(StateSample* out) {
+  const WaitingSample w = *waiting_;
+  waiting_.reset();
+  return Update(w.sample, out, w.receive_wall_us);
+}
+
+bool EstimatorProcess::Update(const SensorSample& sample, StateSample* out,
+                              std::optional<int64_t> receive_wall_us) {
+  last_sample_utime_ = std::max(last_sample_utime_, sample.utime);
   // The acceptor judges a command's age against the newest sample, as the
   // plant judges it against the newest it published.
   if (acceptor_ && sample.utime >= acceptor_->newest_sample_utime()) {

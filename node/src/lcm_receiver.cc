@@ -60,12 +60,6 @@ int ChannelLength(const uint8_t* p, int size) {
   return -1;
 }
 
-int64_t WallUtime() {
-  return std::chrono::duration_cast<std::chrono::microseconds>(
-             std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
-
 int ParseIntOrThrow(const std::string& text, const std::string& what, const std::string& url) {
   if (text.empty() || text.find_first_not_of("0123456789") != std::string::npos) {
     throw std::invalid_argument("LCM URL '" + url + "': " + what + " '" + text +
@@ -90,6 +84,12 @@ struct LcmReceiver::Reassembly {
   std::vector<bool> received;
   int remaining = 0;
 };
+
+int64_t ReceiveClockUs() {
+  return std::chrono::duration_cast<std::chrono::microseconds>(
+             std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
 
 UdpmAddress ParseUdpmUrl(const std::string& url_in) {
   std::string url = url_in;
@@ -246,7 +246,7 @@ int LcmReceiver::HandleTimeoutUs(int64_t timeout_us) {
         recv_utime = int64_t{tv.tv_sec} * 1000000 + tv.tv_usec;
       }
     }
-    if (recv_utime < 0) recv_utime = WallUtime();
+    if (recv_utime < 0) recv_utime = ReceiveClockUs();
     handled += HandleDatagram(datagram_.data(), static_cast<int>(size), from.sin_addr.s_addr,
                               from.sin_port, recv_utime);
   }

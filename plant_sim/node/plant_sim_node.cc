@@ -129,6 +129,7 @@ void PlantSimNode::PublishSample() {
   s.status = 0;
   if (plant_.InEndStop()) s.status |= sensor_t::STATUS_ENDSTOP;
   if (plant_.actuators_off()) s.status |= sensor_t::STATUS_ACTUATORS_OFF;
+  if (answer_applied_) s.status |= sensor_t::STATUS_ANSWER_APPLIED;
   lcm_->publish(config_.lcm.channels.sensors, &s);
   latency_tracker_.OnPublished(tick_, tick_utime_, Clock::now());
   gate_.OnSamplePublished(tick_utime_);
@@ -385,6 +386,7 @@ ExitCode PlantSimNode::RunLockstep() {
     const bool off = guard_.tripped() || (answer.flags & kCommandDriveOff) != 0;
     plant_.SetActuatorsOff(off);
     if (!off) plant_.SetForceCommand(answer.force_n);
+    answer_applied_ = true;  // over the whole next period: the next sample says so
     AdvanceTick();
   }
   return ExitCode::kOk;

@@ -94,6 +94,9 @@ class PlantSimNode {
   int64_t tick_utime_ = 0;  // its utime
   bool fallback_active_ = false;
   sensor_t last_sensor_{};
+  /// Lockstep: the period before the next sample applied the answer to the
+  /// sample before it (sensor_t::STATUS_ANSWER_APPLIED).
+  bool answer_applied_ = false;
   CommandGate gate_;
   LoopLatencyTracker latency_tracker_;
   TickAccounting tick_accounting_;

@@ -16,12 +16,6 @@ namespace {
 using safety::OperatorCommand;
 using safety::SupervisorState;
 
-int64_t WallUs() {
-  return std::chrono::duration_cast<std::chrono::microseconds>(
-             std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
-
 int64_t NewSessionId() {
   std::random_device device;
   std::uniform_int_distribution<int64_t> id(1, INT64_MAX);
@@ -50,7 +44,7 @@ SafetyNode::SafetyNode(const StackConfig& config, lcm::LCM* lcm,
   receiver_.Subscribe(config.lcm.channels.command_nominal, &SafetyNode::OnNominal, this);
   receiver_.Subscribe(config.lcm.channels.operator_command, &SafetyNode::OnOperator, this);
   receiver_.Subscribe(config.lcm.channels.health, &SafetyNode::OnHealth, this);
-  last_operator_wall_us_ = WallUs();
+  last_operator_wall_us_ = ReceiveClockUs();
 }
 
 void SafetyNode::OnState(const lcm::ReceiveBuffer* rbuf, const std::string&, const state_t* msg) {
@@ -58,7 +52,8 @@ void SafetyNode::OnState(const lcm::ReceiveBuffer* rbuf, const std::string&, con
   // reads a backlog of states while its heartbeat monitor has not yet heard
   // what came meanwhile: it holds before it answers any of them.
   if (rbuf->recv_utime > 0) {
-    const std::string stalled = process_.supervisor().InputWaitFault(WallUs() - rbuf->recv_utime);
+    const std::string stalled =
+        process_.supervisor().InputWaitFault(ReceiveClockUs() - rbuf->recv_utime);
     if (!stalled.empty()) Fault(stalled);
   }
   safety::SafetyOutput out;
@@ -81,7 +76,7 @@ void SafetyNode::OnOperator(const lcm::ReceiveBuffer*, const std::string&,
   };
   // Who sent it and when, before what it asks: the actuators' rule (MAC,
   // wall-clock window, seq per console).
-  const int64_t now_us = WallUs();
+  const int64_t now_us = ReceiveClockUs();
   const OperatorVerdict verdict =
       operator_check_.Check(msg->operator_id, msg->seq, msg->utime, auth_.Verify(*msg), now_us);
   if (verdict != OperatorVerdict::kAccepted) {
@@ -118,7 +113,7 @@ void SafetyNode::OnOperator(const lcm::ReceiveBuffer*, const std::string&,
 }
 
 void SafetyNode::OnHealth(const lcm::ReceiveBuffer*, const std::string&, const health_t* msg) {
-  const std::string fault = monitor_.OnHeartbeat(msg->name, msg->state, msg->seq, WallUs());
+  const std::string fault = monitor_.OnHeartbeat(msg->name, msg->state, msg->seq, ReceiveClockUs());
   if (!fault.empty()) Fault(fault);
 }
 
@@ -132,7 +127,7 @@ void SafetyNode::Fault(const std::string& reason) {
 }
 
 void SafetyNode::Periodic() {
-  const int64_t now_us = WallUs();
+  const int64_t now_us = ReceiveClockUs();
   const SupervisorState s = process_.supervisor().state();
   monitor_.SetMoving(s == SupervisorState::kArming || s == SupervisorState::kArmed, now_us);
   for (const std::string& fault : monitor_.CheckSilence(now_us)) Fault(fault);
@@ -148,7 +143,7 @@ void SafetyNode::Periodic() {
 
 void SafetyNode::MaybeAnnounce(bool force) {
   const safety::Supervisor& sup = process_.supervisor();
-  const int64_t now_us = WallUs();
+  const int64_t now_us = ReceiveClockUs();
   const bool changed =
       sup.state() != announced_state_ || sup.transitions() != announced_transitions_;
   const bool due = announced_utime_ < 0 || sup.utime() - announced_utime_ >= kAnnounceStackUs ||

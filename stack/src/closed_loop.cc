@@ -212,7 +212,10 @@ ClosedLoopSummary RunClosedLoop(const StackConfig& config, const Scenario& scena
     if (has_safe) {
       ForceCommand applied = safe.command;
       applied.force_n = f_safe;
-      estimator.OnCommand(applied);
+      // In process every answer comes before the next sample: no sample
+      // ever waits for one here, so no estimate is released.
+      StateSample released;
+      estimator.OnCommand(applied, &released);
     }
     if (csv) {
       *csv << static_cast<double>(utime) * 1e-6;

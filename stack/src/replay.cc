@@ -648,7 +648,11 @@ EstimatorReplayResult ReplayEstimator(const StackConfig& config, const RecordedL
         const force_command_t& command = log.safe[static_cast<size_t>(index)];
         ++r.commands;
         if (!AllFinite(command.force_n)) ++r.rejected_commands;
-        process.OnCommand(FromMessage(command), std::nullopt, auth.Verify(command));
+        // A sample that waited for this answer is estimated now.
+        StateSample state;
+        if (process.OnCommand(FromMessage(command), &state, std::nullopt, auth.Verify(command))) {
+          compare(state);
+        }
       } else if (channel == Channel::kSensors) {
         ++r.sensor_samples;
         StateSample state;

@@ -48,12 +48,12 @@ void RunProcess(int n, bool live, bool forge, ProcessRun* run) {
     ForceCommand command;
     command.utime = command.sample_utime = sample.utime;
     command.force_n = sample.force_n;
-    process.OnCommand(command, wall);
+    EXPECT_FALSE(process.OnCommand(command, &out, wall));
     if (forge && k == 400) {
       ForceCommand forged = command;
       forged.utime = forged.sample_utime = kForgedUtime;
       forged.force_n = Vector6d::Constant(40.0);
-      process.OnCommand(forged, wall);
+      EXPECT_FALSE(process.OnCommand(forged, &out, wall));
     }
   }
 }
@@ -129,7 +129,7 @@ void RunWithResend(int n, bool live, int resend_at, ProcessRun* run, int* copies
     ForceCommand command;
     command.utime = command.sample_utime = sample.utime;
     command.force_n = sample.force_n;
-    process.OnCommand(command, wall);
+    EXPECT_FALSE(process.OnCommand(command, &out, wall));
   }
 }
 

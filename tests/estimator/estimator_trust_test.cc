@@ -48,7 +48,7 @@ void RunEstimator(bool trusted, Forgery forgery, EstimatorRun* run) {
     command.seq = 10 * k;
     command.session_id = kSession;
     command.force_n = sample.force_n;
-    process.OnCommand(command);
+    EXPECT_FALSE(process.OnCommand(command, &out));
     // After the real one, as a forger who copies it would: the later command
     // for a sample is the one the process model uses.
     if (forgery != Forgery::kNone && k >= 200 && k % 10 == 0) {
@@ -68,7 +68,7 @@ void RunEstimator(bool trusted, Forgery forgery, EstimatorRun* run) {
         case Forgery::kNone:
           break;
       }
-      process.OnCommand(forged, std::nullopt, authentic);
+      EXPECT_FALSE(process.OnCommand(forged, &out, std::nullopt, authentic));
     }
   }
 }
@@ -121,14 +121,14 @@ TEST(EstimatorTrust, CommandsBeforeAnyAnnouncementAreNotBelieved) {
   command.utime = command.sample_utime = sample.utime;
   command.session_id = kSession;
   command.force_n = sample.force_n;
-  process.OnCommand(command);
+  EXPECT_FALSE(process.OnCommand(command, &out));
   EXPECT_EQ(counters.counter("rejected_command_no_session"), 1);
   EXPECT_EQ(process.OnAnnouncement({sample.utime + 1000, 1, kSession}, true, kWallUs),
             AnnouncementVerdict::kFuture);
   EXPECT_EQ(process.OnAnnouncement({sample.utime, 1, kSession}, true, kWallUs),
             AnnouncementVerdict::kAdopted);
   command.seq = 1;
-  process.OnCommand(command);
+  EXPECT_FALSE(process.OnCommand(command, &out));
   EXPECT_EQ(counters.rejected_inputs(), 2);  // the command and the announcement from the future
   EXPECT_EQ(process.acceptor()->accepted(), 1);
 }

@@ -112,13 +112,20 @@ LockstepResult LockstepRun(const std::string& folder, int port, const std::strin
   }
   std::printf(
       "[lockstep resend] lose %s: plant_sim exit %d after %.2f s, %zu truth samples, "
-      "lockstep_resends %lld, resends_answered estimator %lld controller %lld safety %lld\n",
+      "lockstep_resends %lld, resends_answered estimator %lld controller %lld safety %lld, "
+      "estimator samples_waited_for_answer %lld answer_not_heard %lld\n",
       lose.empty() ? "nothing" : lose.c_str(), run.plant_exit, run.wall_s, run.truth.size(),
       static_cast<long long>(test::HealthCounter(run.health["plant_sim"], "lockstep_resends")),
       static_cast<long long>(test::HealthCounter(run.health["estimator"], "resends_answered")),
       static_cast<long long>(test::HealthCounter(run.health["controller"], "resends_answered")),
-      static_cast<long long>(test::HealthCounter(run.health["safety"], "resends_answered")));
+      static_cast<long long>(test::HealthCounter(run.health["safety"], "resends_answered")),
+      static_cast<long long>(
+          test::HealthCounter(run.health["estimator"], "samples_waited_for_answer")),
+      static_cast<long long>(test::HealthCounter(run.health["estimator"], "answer_not_heard")));
   std::fflush(stdout);
+  // A sample that overtook its answer waited for it (EstimatorProcess::
+  // OnSensor): the answer had reached the plant, so it reaches every socket.
+  EXPECT_EQ(test::HealthCounter(run.health["estimator"], "answer_not_heard"), 0);
   return run;
 }
 

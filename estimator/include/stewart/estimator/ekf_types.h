@@ -30,6 +30,9 @@ struct SensorSample {
   bool legs_valid = true;  ///< false when the device flags a leg fault
   bool imu_valid = true;   ///< false when the device flags an IMU fault
   bool has_orientation = false;
+  /// The source applied the answer to its previous sample over the interval
+  /// ending here (sensor_t::STATUS_ANSWER_APPLIED; lockstep plant_sim).
+  bool previous_answer_applied = false;
 };
 
 /// The filter's output for one sample.

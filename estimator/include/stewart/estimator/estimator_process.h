@@ -44,16 +44,37 @@ class EstimatorProcess {
                                      int64_t wall_us);
   /// A safe command arrived: the process model's input (non-finite ones,
   /// ones with an implausible time and, with `trust`, ones the actuators
-  /// would not apply are rejected and counted).
-  void OnCommand(const ForceCommand& command, std::optional<int64_t> receive_wall_us = std::nullopt,
-                 bool authentic = true);
+  /// would not apply are rejected and counted). Returns true when `out`
+  /// holds an estimate to publish: that of a sample that waited for this
+  /// command (see OnSensor).
+  bool OnCommand(const ForceCommand& command, StateSample* out,
+                 std::optional<int64_t> receive_wall_us = std::nullopt, bool authentic = true);
   /// A sensor sample arrived. Returns true when `out` holds an estimate to
   /// publish. The sample last answered, received again (plant_sim's lockstep
   /// resend: an answer was lost downstream), is answered again with the same
   /// estimate without a second EKF update (common/resend_answer.h; counted
   /// `resends_answered`).
+  ///
+  /// A sample whose source applied the answer to the previous sample
+  /// (previous_answer_applied, lockstep) while that answer has not arrived
+  /// here waits for it: multicast keeps the order of one sender only, and
+  /// the plant's sample can overtake the safety process's command on the
+  /// way to this socket (seen in about one tick in five on two busy cores).
+  /// Predicting with the command before it would make a lockstep run
+  /// depend on the scheduler. The answer's arrival releases the sample
+  /// (OnCommand); so do a newer sample and FlushWaiting (counted
+  /// `answer_not_heard`: the EKF then predicts with what it has).
   bool OnSensor(const SensorSample& sample, StateSample* out,
                 std::optional<int64_t> receive_wall_us = std::nullopt);
+  /// A sample waiting for its answer longer than kAnswerWait_s of wall time
+  /// (`wall_us`, the receive clock) is updated without it. Returns true when
+  /// `out` holds its estimate. The node calls it between reads.
+  bool FlushWaiting(int64_t wall_us, StateSample* out);
+  /// Whether a sample waits for its answer (the node then polls often).
+  bool waiting() const { return waiting_.has_value(); }
+  /// Below plant_sim's lockstep resend period (0.2 s), so a command lost to
+  /// this process alone costs one late estimate, not a resend.
+  static constexpr double kAnswerWait_s = 0.05;
   /// Perfect-state mode: the ground truth, republished as the estimate.
   bool OnTruth(const StateSample& truth, StateSample* out,
                std::optional<int64_t> receive_wall_us = std::nullopt);
@@ -65,6 +86,16 @@ class EstimatorProcess {
  private:
   /// Publishing bookkeeping: non-finite estimates are rejected, never sent.
   bool Emit(const StateSample& state, StateSample* out);
+  /// The EKF update of an accepted sample and its estimate.
+  bool Update(const SensorSample& sample, StateSample* out, std::optional<int64_t> receive_wall_us);
+  /// The waiting sample, updated now (its answer came, or will not).
+  bool ReleaseWaiting(StateSample* out);
+
+  struct WaitingSample {
+    SensorSample sample;
+    std::optional<int64_t> receive_wall_us;
+    int64_t answer_utime = 0;  ///< the sample_utime of the answer it waits for
+  };
 
   Ekf ekf_;
   HealthCounters* counters_;
@@ -73,6 +104,9 @@ class EstimatorProcess {
   ResendAnswer resend_;
   StateSample last_answer_;  ///< the estimate answering the sample resend_ holds
   int64_t seq_ = 0;
+  std::optional<WaitingSample> waiting_;
+  int64_t last_sample_utime_ = -1;    ///< the newest sample updated (or waiting)
+  int64_t newest_answer_utime_ = -1;  ///< the newest sample_utime of a plausible command
 };
 
 }  // namespace stewart

@@ -34,6 +34,10 @@
 
 namespace stewart {
 
+/// Now on the clock of recv_utime (the wall clock, us): how long a message
+/// has waited is ReceiveClockUs() - rbuf->recv_utime.
+int64_t ReceiveClockUs();
+
 /// The parts of a udpm:// URL a receiver needs.
 struct UdpmAddress {
   std::string group = "239.255.76.67";
