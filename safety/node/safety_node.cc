@@ -47,21 +47,26 @@ SafetyNode::SafetyNode(const StackConfig& config, lcm::LCM* lcm,
   last_operator_wall_us_ = ReceiveClockUs();
 }
 
-void SafetyNode::OnState(const lcm::ReceiveBuffer* rbuf, const std::string&, const state_t* msg) {
+void SafetyNode::HoldIfStalled(const lcm::ReceiveBuffer* rbuf) {
   // Stopped (SIGSTOP, a debugger, a starved CPU) and continued, this process
-  // reads a backlog of states while its heartbeat monitor has not yet heard
-  // what came meanwhile: it holds before it answers any of them.
-  if (rbuf->recv_utime > 0) {
-    const std::string stalled =
-        process_.supervisor().InputWaitFault(ReceiveClockUs() - rbuf->recv_utime);
-    if (!stalled.empty()) Fault(stalled);
-  }
+  // reads a backlog while its heartbeat monitor has not yet heard what came
+  // meanwhile: it holds before it answers any of it. A nominal too: the
+  // state it completes may have been read before the stop.
+  if (rbuf->recv_utime <= 0) return;
+  const std::string stalled =
+      process_.supervisor().InputWaitFault(ReceiveClockUs() - rbuf->recv_utime);
+  if (!stalled.empty()) Fault(stalled);
+}
+
+void SafetyNode::OnState(const lcm::ReceiveBuffer* rbuf, const std::string&, const state_t* msg) {
+  HoldIfStalled(rbuf);
   safety::SafetyOutput out;
   if (process_.OnState(FromMessage(*msg), &out, rbuf->recv_utime)) Publish(out);
 }
 
 void SafetyNode::OnNominal(const lcm::ReceiveBuffer* rbuf, const std::string&,
                            const force_command_t* msg) {
+  HoldIfStalled(rbuf);
   safety::SafetyOutput out;
   if (process_.OnNominal(FromMessage(*msg), &out, rbuf->recv_utime)) Publish(out);
 }

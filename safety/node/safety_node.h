@@ -52,6 +52,9 @@ class SafetyNode {
   /// Wall-time duties between messages: heartbeat silence, the operator's
   /// dead-man, the periodic announcement.
   void Periodic();
+  /// HOLD (a latched fault) when the input in `rbuf` waited too long to be
+  /// read while the platform moves (Supervisor::InputWaitFault).
+  void HoldIfStalled(const lcm::ReceiveBuffer* rbuf);
   void Fault(const std::string& reason);
 
   const StackConfig& config_;

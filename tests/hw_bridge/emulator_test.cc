@@ -152,10 +152,13 @@ TEST(SampleSchedule, SamplesOnThePeriodGridAndDropsEveryNth) {
 TEST(SampleSchedule, SkipsTheBacklogAfterBeingDescheduled) {
   SampleSchedule schedule(1000, 0);
   const uint64_t t0 = SampleSchedule::kDeviceEpochUs;
-  // Ten periods behind: still caught up sample by sample.
+  // Ten periods behind: still caught up sample by sample, not a stall.
+  EXPECT_FALSE(schedule.Stalled(t0 + 11'000));
   EXPECT_EQ(schedule.Take(t0 + 11'000).time_us, t0 + 1000);
   EXPECT_EQ(schedule.skipped(), 0U);
-  // Far behind: one sample at the newest grid point, the rest skipped.
+  // Far behind: a stall (the node drops the commands queued meanwhile), one
+  // sample at the newest grid point, the rest skipped.
+  EXPECT_TRUE(schedule.Stalled(t0 + 50'500));
   const SampleSchedule::Sample s = schedule.Take(t0 + 50'500);
   EXPECT_EQ(s.time_us, t0 + 50'000);
   EXPECT_TRUE(s.send);

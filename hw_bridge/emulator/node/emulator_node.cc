@@ -31,6 +31,12 @@ bool WaitReadable(int fd, Clock::time_point deadline) {
   return ppoll(&pfd, 1, &timeout, nullptr) > 0;
 }
 
+/// Whether fd has something to read now.
+bool Readable(int fd) {
+  pollfd pfd{fd, POLLIN, 0};
+  return poll(&pfd, 1, 0) > 0 && (pfd.revents & POLLIN) != 0;
+}
+
 hw::PlantBackendOptions BackendOptions(bool noise) {
   hw::PlantBackendOptions o;
   o.noise = noise;
@@ -124,6 +130,29 @@ void EmulatorNode::OnFrame(const hw::DecodedFrame& frame, uint64_t rx_us) {
   }
 }
 
+void EmulatorNode::DiscardQueuedCommands() {
+  // The firmware's rule after its loop stalled: the frames its receiver
+  // queued meanwhile are not applied. Read now, each would look fresh (age is
+  // judged on arrival) and drive the legs in turn with commands answering
+  // samples taken before the stall; the next frame sent after it drives.
+  const uint64_t behind_us = DeviceNow() - schedule_.next_tick_us();
+  long discarded = 0;
+  // Bounded: a flood while draining must not keep the loop from its samples.
+  for (int reads = 0; reads < 100000 && Readable(link_->fd()); ++reads) {
+    const long n = link_->Receive(rx_.data(), rx_.size(), 0);
+    if (n < 0) break;
+    if (n == 0) continue;  // a datagram from another peer (counted by the link)
+    reader_.Feed(
+        rx_.data(), static_cast<std::size_t>(n), rx_.size(),
+        [&](const hw::DecodedFrame& f) { discarded += f.type == hw::FrameType::kCommand ? 1 : 0; },
+        [&](hw::DecodeStatus) { device_.OnRxError(); });
+  }
+  stale_commands_discarded_ += discarded;
+  spdlog::warn(
+      "hw_emulator: loop stalled {} ms: {} command frame(s) queued meanwhile discarded ({} in all)",
+      behind_us / 1000, discarded, stale_commands_discarded_);
+}
+
 ExitCode EmulatorNode::Run() {
   start_ = Clock::now();
   start_epoch_us_ = std::chrono::duration_cast<std::chrono::microseconds>(
@@ -138,10 +167,13 @@ ExitCode EmulatorNode::Run() {
       break;
     }
     if (schedule_.Due(DeviceNow())) {
+      if (schedule_.Stalled(DeviceNow())) DiscardQueuedCommands();
       Tick(DeviceNow());
       continue;
     }
     if (!WaitReadable(link_->fd(), steady_at(schedule_.next_tick_us()))) continue;
+    // Stopped while it waited: what is queued is the stall's (above).
+    if (schedule_.Stalled(DeviceNow())) continue;
     const long n = link_->Receive(rx_.data(), rx_.size(), 0);
     if (n <= 0) continue;
     const uint64_t rx_us = DeviceNow();
@@ -154,8 +186,10 @@ ExitCode EmulatorNode::Run() {
         [&](hw::DecodeStatus) { device_.OnRxError(); });
   }
   if (!options_.pty_link.empty()) unlink(options_.pty_link.c_str());
-  spdlog::info("hw_emulator: stopped after {} samples ({} skipped while descheduled)",
-               schedule_.ticks(), schedule_.skipped());
+  spdlog::info(
+      "hw_emulator: stopped after {} samples ({} skipped while descheduled, {} command frames "
+      "discarded after stalls)",
+      schedule_.ticks(), schedule_.skipped(), stale_commands_discarded_);
   return ExitCode::kOk;
 }
 

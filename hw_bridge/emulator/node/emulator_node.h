@@ -52,6 +52,9 @@ class EmulatorNode {
   uint64_t DeviceNow() const;
   void Tick(uint64_t now_us);
   void OnFrame(const hw::DecodedFrame& frame, uint64_t rx_us);
+  /// After a stall of its loop: the command frames queued meanwhile are read
+  /// and dropped (counted), never applied.
+  void DiscardQueuedCommands();
 
   const StackConfig& config_;
   lcm::LCM* lcm_;
@@ -63,6 +66,7 @@ class EmulatorNode {
   hw::DeviceEmulator device_;
   hw::SampleSchedule schedule_;
   hw::FrameReader reader_;
+  long stale_commands_discarded_ = 0;
   Clock::time_point start_;
   /// The host time base of hw_bridge (HostClock): the wall clock read once,
   /// advanced by the monotonic clock. Used only to stamp the ground truth.

@@ -6,7 +6,7 @@ SampleSchedule::SampleSchedule(uint64_t period_us, int drop_every)
     : period_us_(period_us), drop_every_(drop_every), next_tick_us_(kDeviceEpochUs + period_us) {}
 
 SampleSchedule::Sample SampleSchedule::Take(uint64_t now_us) {
-  if (now_us > next_tick_us_ + kMaxBacklogPeriods * period_us_) {
+  if (Stalled(now_us)) {
     const uint64_t missed = (now_us - next_tick_us_) / period_us_;
     next_tick_us_ += missed * period_us_;
     skipped_ += missed;

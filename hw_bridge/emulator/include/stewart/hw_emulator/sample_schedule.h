@@ -21,6 +21,12 @@ class SampleSchedule {
 
   uint64_t next_tick_us() const { return next_tick_us_; }
   bool Due(uint64_t now_us) const { return now_us >= next_tick_us_; }
+  /// Further behind than kMaxBacklogPeriods: the device's loop was not
+  /// running (descheduled, stopped), and what its receiver queued meanwhile
+  /// arrived at times it cannot tell.
+  bool Stalled(uint64_t now_us) const {
+    return now_us > next_tick_us_ + kMaxBacklogPeriods * period_us_;
+  }
 
   struct Sample {
     uint64_t time_us = 0;  ///< on the period grid
