@@ -222,7 +222,12 @@ SafetyOutput SafetyProcess::Supervise(const StateSample& state, const Vector6d& 
   counters_->SetState(filtered && !mode.drive_off() && mode.state != SupervisorState::kHold
                           ? health_state::kOk
                           : health_state::kDegraded);
-  if (mode.drive_off()) {
+  // Without a usable state every force is open loop (a restarted EKF's
+  // first estimates, a diverged one): the actuators off lock the legs (the
+  // lead screws hold; plant_sim and the emulator model it), which needs no
+  // state. A safe stop computed from such a state pushed a held platform to
+  // 0.06 m/s after a 2 s device stall (ProcessFaults.HwEmulatorStoppedAndKilled).
+  if (mode.drive_off() || !step.state_usable) {
     counters_->Count("drive_off_commands");
     // Not a control law's output: flagged a fallback, as the safe stop is.
     return Emit(Vector6d::Zero(), sample_utime,

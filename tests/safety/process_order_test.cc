@@ -161,6 +161,15 @@ TEST(SafetyProcessOrder, AfterAnEstimatorRestartLateAnswersGiveTheSameCommands) 
   EXPECT_TRUE(prompt[5].flags & kCommandFallback);
   EXPECT_NE(prompt[5].fallback_reason, 0);
   EXPECT_TRUE(prompt[34].flags & kCommandFallback);
+  // Every unusable state, ARMED (5) then HOLD, got the actuators off with
+  // zero force: a force from such a state would be open loop.
+  for (int k = 5; k < 35; ++k) {
+    EXPECT_EQ(prompt[k].flags & (kCommandDriveOff | kCommandInvalidInput),
+              kCommandDriveOff | kCommandInvalidInput)
+        << k;
+    EXPECT_EQ(prompt[k].force_n, Vector6d::Zero()) << k;
+  }
+  EXPECT_EQ(prompt[36].flags & kCommandDriveOff, 0);
   EXPECT_EQ(prompt[35].fallback_reason, 0);
   EXPECT_EQ(prompt[36].fallback_reason, 0);
   EXPECT_EQ(prompt[36].state, SupervisorState::kHold);
