@@ -1,5 +1,5 @@
 // Process faults on a running real-time stack: each of plant_sim, safety,
-// stewart_logger and (hardware mode) hw_emulator is stopped (SIGSTOP, then
+// stewart_logger and (hardware mode) hw_emulator and hw_bridge is stopped (SIGSTOP, then
 // SIGCONT) and killed (SIGKILL, then started again) at a random instant
 // once the supervisor is ARMED (seeded: the seed is printed, and
 // STEWART_FAULT_SEED=N repeats it). The real processes on a private URL
@@ -26,7 +26,7 @@
 // STEWART_SOAK_S=S repeats the faults of each test at random instants for S
 // seconds of wall time (default 0: once each, the CI's short profile).
 //
-// LCM ports 8020-8023 (this file owns 8020-8029), device UDP ports 8028
+// LCM ports 8020-8024 (this file owns 8020-8029), device UDP ports 8028
 // (hw_emulator) and 8029 (hw_bridge). Each test holds the build folder's
 // launcher lock: a real-time stack alone on the shared cores.
 #include <gtest/gtest.h>
@@ -65,6 +65,7 @@ constexpr int kPortPlantSim = 8020;
 constexpr int kPortSafety = 8021;
 constexpr int kPortLogger = 8022;
 constexpr int kPortHwEmulator = 8023;
+constexpr int kPortHwBridge = 8024;
 constexpr int kDevicePort = 8028;  // hw_bridge binds kDevicePort + 1
 
 int64_t WallUs() {
@@ -204,6 +205,9 @@ class Stack {
   std::unique_ptr<test::ChildProcess> StartEmulator() const {
     return std::make_unique<test::ChildProcess>(With({HW_EMULATOR_PATH}));
   }
+  std::unique_ptr<test::ChildProcess> StartBridge() const {
+    return std::make_unique<test::ChildProcess>(With({HW_BRIDGE_PATH}));
+  }
   void Start() {
     logger = StartLogger(false);
     safety = StartSafety();
@@ -212,7 +216,7 @@ class Stack {
     estimator = std::make_unique<test::ChildProcess>(With({ESTIMATOR_PATH}));
     if (hardware_) {
       emulator = StartEmulator();
-      bridge = std::make_unique<test::ChildProcess>(With({HW_BRIDGE_PATH}));
+      bridge = StartBridge();
     } else {
       plant = StartPlantSim();
     }
@@ -622,26 +626,34 @@ TEST(ProcessFaults, SafetyStoppedAndKilled) {
 // goes down (hw_bridge.link_timeout_s: a FAULT heartbeat) and the stack has
 // no state; the device's own watchdog zeroes the drive. A restarted device
 // follows the bridge's link session again (docs/wire-protocol.md).
-TEST(ProcessFaults, HwEmulatorStoppedAndKilled) {
+/// The device side (hardware mode) stopped and killed: `name` is hw_emulator
+/// (the device: hw_bridge's link times out and it reports FAULT) or
+/// hw_bridge (no sensor_t at all; its heartbeat stops, or restarts). Either
+/// way no sample reaches the stack: HOLD, the device's watchdog cuts the
+/// drive, and after the operator's reset and resume the platform moves on.
+void DeviceSideStoppedAndKilled(const std::string& name, int port, uint64_t seed_stream) {
   test::LauncherLock lock;
   PrintSeed();
-  std::mt19937_64 rng(Seed() * 4 + 3);
-  Stack stack("hw_emulator", kPortHwEmulator, true);
+  std::mt19937_64 rng(Seed() * 4 + seed_stream);
+  Stack stack(name, port, true);
   stack.Start();
   ASSERT_TRUE(stack.WaitArmed(15.0)) << "the stack did not arm";
   const StackConfig& c = stack.config();
-  // The bridge's link timeout, its FAULT heartbeat (<= a period later), the
-  // test hearing the HOLD, and slack for a loaded host.
-  const double hold_bound_ms =
-      1e3 * c.hw_bridge.link_timeout_s + 1e3 / c.lcm.health_rate_hz + 150.0;
+  const bool bridge = name == "hw_bridge";
+  std::unique_ptr<test::ChildProcess>* target = bridge ? &stack.bridge : &stack.emulator;
+  // What tells the supervisor (the bridge's link timeout and its FAULT
+  // heartbeat, or the bridge's own heartbeat lost), a heartbeat period, and
+  // slack for a loaded host.
+  const double detect_s = bridge ? c.supervisor.heartbeat_timeout_s : c.hw_bridge.link_timeout_s;
+  const double hold_bound_ms = 1e3 * detect_s + 1e3 / c.lcm.health_rate_hz + 150.0;
   const auto started = std::chrono::steady_clock::now();
   int rounds = 0;
   do {
     for (const bool kill : {false, true}) {
-      const std::string what = std::string("hw_emulator ") + (kill ? "kill" : "stop");
+      const std::string what = name + (kill ? " kill" : " stop");
       const FaultRun run = InjectFault(
-          stack, &rng, "hw_emulator", &stack.emulator, kill, StopSeconds(c),
-          [&] { return stack.StartEmulator(); },
+          stack, &rng, name, target, kill, StopSeconds(c),
+          [&] { return bridge ? stack.StartBridge() : stack.StartEmulator(); },
           [](const SafeTimes& t) { return t.hold_ms.has_value(); }, StopSeconds(c) + 2.0);
       ASSERT_TRUE(run.times.hold_ms) << what << ": never held";
       EXPECT_LE(*run.times.hold_ms, hold_bound_ms) << run.times.hold_reason;
@@ -653,9 +665,20 @@ TEST(ProcessFaults, HwEmulatorStoppedAndKilled) {
       ASSERT_TRUE(stack.WaitArmed(5.0, WallUs() - 1'000'000)) << what << ": not back to normal";
     }
   } while (SoakGoesOn(started, &rounds));
-  std::printf("[process-fault] hw_emulator: %d round(s); %s\n", rounds,
+  std::printf("[process-fault] %s: %d round(s); %s\n", name.c_str(), rounds,
               test::Describe(stack.bus.truth).c_str());
   test::ExpectWithinLimits(stack.bus.truth);
+}
+
+TEST(ProcessFaults, HwEmulatorStoppedAndKilled) {
+  DeviceSideStoppedAndKilled("hw_emulator", kPortHwEmulator, 3);
+}
+
+// The bridge stopped: it holds a backlog of the device's frames and of safe
+// commands when it is continued; killed, a new bridge starts a new link
+// session the device follows (docs/wire-protocol.md, "Sessions").
+TEST(ProcessFaults, HwBridgeStoppedAndKilled) {
+  DeviceSideStoppedAndKilled("hw_bridge", kPortHwBridge, 0x5bd1e995);
 }
 
 /// stewart_log_export --check on `log`: its output (the check's lines) and
