@@ -43,6 +43,7 @@
 #include <limits>
 #include <map>
 #include <random>
+#include <set>
 #include <string>
 #include <thread>
 #include <vector>
@@ -217,6 +218,36 @@ std::vector<uint8_t> Mutate(Mode mode, const uint8_t* data, size_t size, double 
   return payload;
 }
 
+/// The messages this process sent last, by content: it hears its own
+/// datagrams on the bus and must not change a copy again (a NaN copy's seq
+/// + 1 would become + 2, a stale copy would move twice).
+class SentRecently {
+ public:
+  void Add(const std::vector<uint8_t>& payload) {
+    const uint64_t h = Hash(payload.data(), payload.size());
+    if (ring_.size() == kKept) {
+      set_.erase(set_.find(ring_[next_]));
+      ring_[next_] = h;
+    } else {
+      ring_.push_back(h);
+    }
+    next_ = (next_ + 1) % kKept;
+    set_.insert(h);
+  }
+  bool Contains(const uint8_t* data, size_t size) const { return set_.count(Hash(data, size)) > 0; }
+
+ private:
+  static constexpr size_t kKept = 4096;  // > a second of copies at the default rate
+  static uint64_t Hash(const uint8_t* data, size_t size) {
+    uint64_t h = 1469598103934665603ULL;  // FNV-1a
+    for (size_t i = 0; i < size; ++i) h = (h ^ data[i]) * 1099511628211ULL;
+    return h;
+  }
+  std::vector<uint64_t> ring_;
+  size_t next_ = 0;
+  std::multiset<uint64_t> set_;
+};
+
 ExitCode Run(const StackConfig& config, const Options& options) {
   if (options.shift_s < 0.0 && options.mode != Mode::kClockJump) {
     spdlog::error("stewart_inject: --shift-s must not be negative for --mode stale|future");
@@ -272,17 +303,20 @@ ExitCode Run(const StackConfig& config, const Options& options) {
     for (const std::string& c : channels) wanted[c] = true;
     auto next_allowed = start;
     JumpedClock jumped(static_cast<int64_t>(std::llround(options.shift_s * 1e6)));
+    SentRecently own;
     receiver.SubscribeAll([&](const lcm::ReceiveBuffer& rbuf, const std::string& channel) {
       if (!wanted.count(channel)) return;
+      const auto* data = static_cast<const uint8_t*>(rbuf.data);
+      if (own.Contains(data, rbuf.data_size)) return;
       const auto now = std::chrono::steady_clock::now();
       if (now < next_allowed) return;
       next_allowed = now + std::chrono::duration_cast<std::chrono::steady_clock::duration>(period);
-      const auto* data = static_cast<const uint8_t*>(rbuf.data);
       const std::vector<uint8_t> payload =
           options.mode == Mode::kClockJump
               ? jumped.Next(data, rbuf.data_size)
               : Mutate(options.mode, data, rbuf.data_size, options.shift_s, &rng);
       if (payload.empty() && options.mode != Mode::kTruncate) return;
+      own.Add(payload);
       send(LcmShortDatagram(seqno++, channel, payload));
     });
     while (!StopRequested() && std::chrono::steady_clock::now() < end) receiver.HandleTimeout(10);
