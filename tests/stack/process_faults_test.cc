@@ -43,6 +43,7 @@
 #include <memory>
 #include <optional>
 #include <random>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -538,6 +539,26 @@ bool SoakGoesOn(const std::chrono::steady_clock::time_point& started, int* round
          SoakSeconds();
 }
 
+/// The recorder lost nothing the test heard: every sensor sample (utime,
+/// seq) heard on the bus is in the log. Stops the logger.
+void ExpectTheLogHasEverySampleHeard(Stack& stack) {
+  ASSERT_EQ(stack.logger->Stop(SIGTERM), 0);
+  std::set<std::pair<int64_t, int64_t>> logged;
+  lcm::LogFile log(stack.log_path(), "r");
+  ASSERT_TRUE(log.good());
+  while (const lcm::LogEvent* event = log.readNextEvent()) {
+    if (event->channel != stack.config().lcm.channels.sensors) continue;
+    sensor_t s;
+    if (s.decode(event->data, 0, event->datalen) >= 0) logged.emplace(s.utime, s.seq);
+  }
+  long missing = 0;
+  for (const auto& s : stack.bus.sensors) missing += logged.count({s.msg.utime, s.msg.seq}) ? 0 : 1;
+  std::printf("[process-fault] recorder: %zu sensor samples heard, %ld not in the log\n",
+              stack.bus.sensors.size(), missing);
+  std::fflush(stdout);
+  EXPECT_EQ(missing, 0) << "the recorder lost sensor samples the test heard";
+}
+
 // The plant dies or stops: no sensor sample, so no state and no command;
 // the supervisor holds when plant_sim's heartbeat is lost
 // (supervisor.heartbeat_timeout_s) or restarts (its sequence starts over).
@@ -578,6 +599,7 @@ TEST(ProcessFaults, PlantSimStoppedAndKilled) {
   std::printf("[process-fault] plant_sim: %d round(s); %s\n", rounds,
               test::Describe(stack.bus.truth).c_str());
   test::ExpectWithinLimits(stack.bus.truth);
+  ExpectTheLogHasEverySampleHeard(stack);
 }
 
 // The safety process dies or stops: no safe command; the actuators' command
@@ -620,6 +642,7 @@ TEST(ProcessFaults, SafetyStoppedAndKilled) {
   std::printf("[process-fault] safety: %d round(s); %s\n", rounds,
               test::Describe(stack.bus.truth).c_str());
   test::ExpectWithinLimits(stack.bus.truth);
+  ExpectTheLogHasEverySampleHeard(stack);
 }
 
 // The emulated device stops or dies: no sensor frame, so hw_bridge's link
@@ -668,6 +691,7 @@ void DeviceSideStoppedAndKilled(const std::string& name, int port, uint64_t seed
   std::printf("[process-fault] %s: %d round(s); %s\n", name.c_str(), rounds,
               test::Describe(stack.bus.truth).c_str());
   test::ExpectWithinLimits(stack.bus.truth);
+  ExpectTheLogHasEverySampleHeard(stack);
 }
 
 TEST(ProcessFaults, HwEmulatorStoppedAndKilled) {
