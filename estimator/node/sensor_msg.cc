@@ -15,6 +15,8 @@ SensorSample SampleFromMessage(const sensor_t& msg) {
   s.legs_valid = (msg.status & sensor_t::STATUS_LEG_FAULT) == 0;
   s.imu_valid = (msg.status & sensor_t::STATUS_IMU_FAULT) == 0;
   s.previous_answer_applied = (msg.status & sensor_t::STATUS_ANSWER_APPLIED) != 0;
+  s.drive_off =
+      (msg.status & (sensor_t::STATUS_ACTUATORS_OFF | sensor_t::STATUS_DEVICE_WATCHDOG)) != 0;
   return s;
 }
 

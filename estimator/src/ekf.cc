@@ -243,7 +243,8 @@ bool Ekf::InitializeFromLegs(const SensorSample& sample, uint32_t* events) {
   return true;
 }
 
-void Ekf::Predict(double dt_s, int64_t utime, const EulerAngleTrig& trig, uint32_t* events) {
+void Ekf::Predict(double dt_s, int64_t utime, const EulerAngleTrig& trig, bool drive_off,
+                  uint32_t* events) {
   const Vector6d q = x_.segment<6>(kEkfQ);
   const Vector6d qd = x_.segment<6>(kEkfQd);
   const TimedCommand* command = ActingCommand(last_utime_);
@@ -257,9 +258,14 @@ void Ekf::Predict(double dt_s, int64_t utime, const EulerAngleTrig& trig, uint32
   // it would predict the platform sinking against the legs' damping and
   // explain the legs' stillness as model error d, which the controller and
   // the filter then apply as soon as the drive returns.
-  // Any legs with the drive turned off by the supervisor (DISARMED, ESTOP)
-  // are held likewise.
-  const bool legs_held = dynamics_model && ((command_fresh && command->drive_off) ||
+  // Any legs with the drive turned off by the supervisor (DISARMED, ESTOP),
+  // or by the actuators themselves (the plant's command timeout or guard,
+  // the device's watchdog: the sample says so), are held likewise. Without
+  // the sample's word the safe commands the actuators refused were predicted
+  // and d absorbed the stillness; when the drive returned, d's compensation
+  // pushed a held platform to 0.10 m/s in 8 ms (docs/operations.md,
+  // "Several hosts").
+  const bool legs_held = dynamics_model && (drive_off || (command_fresh && command->drive_off) ||
                                             (actuators_.kind == ActuatorKind::kDcMotor &&
                                              (!command_fresh || command->force_n.isZero())));
   const bool use_dynamics = dynamics_model && command_fresh && !legs_held;
@@ -507,7 +513,7 @@ UpdateResult Ekf::Update(const SensorSample& sample) {
     trig = ShiftEulerAngleTrig(trig, now - angles, now);
     angles = now;
   };
-  Predict(dt_s, sample.utime, trig, &events);
+  Predict(dt_s, sample.utime, trig, sample.drive_off, &events);
   last_utime_ = sample.utime;
   if (legs_ok) {
     follow_angles();

@@ -200,7 +200,7 @@ CommandVerdict HwBridge::OnDutyCommand(int64_t utime, const Vector6d& duty) {
   return verdict;
 }
 
-DriveReason HwBridge::CurrentReason() const {
+DriveReason HwBridge::CurrentReason(int64_t host_now_us) const {
   if (!bringup_.enabled && actuator_guard_.tripped()) return DriveReason::kGuard;
   // Before the device follows this bridge, a frame with drive would be
   // refused (it adopts a session only at rest) or, worse, be the first
@@ -209,8 +209,12 @@ DriveReason HwBridge::CurrentReason() const {
   if (command_invalid_) return DriveReason::kInvalid;
   if (!have_command_) return DriveReason::kMissing;
   // Age in stack time: how far the device's samples have moved on since the
-  // sample this command was computed from.
-  const double age_s = static_cast<double>(latest_sample_utime_ - command_utime_) * 1e-6;
+  // sample this command was computed from; and to now on the host's clock,
+  // so that a bridge that was not running (descheduled, stopped) and reads
+  // a backlog of the device's frames does not forward a command from before
+  // the stall as young against them.
+  const int64_t now_utime = std::max(latest_sample_utime_, host_now_us);
+  const double age_s = static_cast<double>(now_utime - command_utime_) * 1e-6;
   if (age_s > hw_.command_timeout_s) return DriveReason::kStale;
   if (command_drive_off_) return DriveReason::kDriveOff;
   return DriveReason::kCommand;
@@ -222,7 +226,7 @@ std::size_t HwBridge::BuildCommandFrame(int64_t host_now_us, uint8_t* out) {
   frame.watchdog_us = static_cast<uint32_t>(std::lround(hw_.device_watchdog_s * 1e6));
   frame.flags = kCommandEnable;
   frame.session = link_session_;
-  last_reason_ = CurrentReason();
+  last_reason_ = CurrentReason(host_now_us);
   if (last_reason_ == DriveReason::kCommand && bringup_.enabled) {
     // The duty as commanded, after the guard on the latest readings.
     const Vector6d duty = guard_.Apply(command_duty_);

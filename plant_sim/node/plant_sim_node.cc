@@ -293,7 +293,12 @@ void PlantSimNode::UpdateTickCounters() {
 }
 
 void PlantSimNode::ApplyRealTimeDecision() {
-  const RealTimeCommandHold::Decision d = hold_.Decide(tick_utime_);
+  // Now on the plant's clock: behind its schedule, the tick's sample time
+  // lags the time that passed (RealTimeCommandHold::Decide).
+  const int64_t now_utime =
+      utime0_ +
+      std::chrono::duration_cast<std::chrono::microseconds>(Clock::now() - rt_start_).count();
+  const RealTimeCommandHold::Decision d = hold_.Decide(tick_utime_, now_utime);
   const bool off = d.actuators_off || guard_.tripped();
   plant_.SetActuatorsOff(off);
   if (!off) {
@@ -324,7 +329,8 @@ ExitCode PlantSimNode::RunRealTime() {
   latency_tracker_ = LoopLatencyTracker(utime0_, period_us_);
   tick_accounting_ = TickAccounting(utime0_, period_us_);
   UpdateTickCounters();
-  const RealTimePacing pacing(period_us_, Clock::now());
+  rt_start_ = Clock::now();
+  const RealTimePacing pacing(period_us_, rt_start_);
   for (tick_ = 0;; ++tick_) {
     const Clock::time_point deadline = pacing.Deadline(tick_);
     while (!StopRequested()) {

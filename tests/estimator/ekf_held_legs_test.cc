@@ -20,9 +20,11 @@ struct HeldRun {
 
 // 2 s at rest at home with noise-free readings; `command` each sample (or
 // none when `with_command` is false).
-HeldRun RunAtRest(const StackConfig& c, bool with_command, const Vector6d& command_n) {
+HeldRun RunAtRest(const StackConfig& c, bool with_command, const Vector6d& command_n,
+                  bool samples_say_drive_off = false) {
   Ekf ekf(c.platform, c.actuators, c.sensors, c.estimator, c.home_pose);
   SensorSample sample;
+  sample.drive_off = samples_say_drive_off;
   sample.leg_length_m = InverseKinematics(c.platform, c.home_pose);
   sample.accel_mps2 = Vector3d(0.0, 0.0, c.platform.gravity_mps2);  // specific force at rest
   sample.gyro_radps = c.sensors.gyro_bias_radps;
@@ -65,11 +67,31 @@ TEST(EkfHeldLegs, HoverCommandUsesTheDynamics) {
   EXPECT_LT(run.d.head<3>().cwiseAbs().maxCoeff(), 0.5) << run.d.transpose();
 }
 
-// The ideal force source is never held: with F = 0 the platform falls, and
-// the estimator must not pretend otherwise.
+// The ideal force source is never held by itself: with F = 0 the platform
+// falls, and the estimator must not pretend otherwise.
 TEST(EkfHeldLegs, IdealForceSourceIsNeverHeld) {
   const HeldRun run = RunAtRest(DefaultStackConfig(), true, Vector6d::Zero());
   EXPECT_EQ(run.held_samples, 0);
+}
+
+// The actuators refused the safe commands (plant_sim's command timeout, the
+// device's watchdog) and the samples say so: the legs are held whatever the
+// commands, so d does not absorb a push that never acted. Before, d grew to
+// explain the stillness, and the controller applied it when the drive came
+// back.
+TEST(EkfHeldLegs, SamplesWithoutDriveAreHeldWhateverTheCommands) {
+  const StackConfig& c = DefaultStackConfig();
+  const Vector6d hover_n = InverseDynamics(
+      EvaluateDynamics(c.platform, c.home_pose, Vector6d::Zero()), Vector6d::Zero());
+  const Vector6d push_n = hover_n + Vector6d::Constant(3.0);
+  const HeldRun said = RunAtRest(c, true, push_n, /*samples_say_drive_off=*/true);
+  EXPECT_GT(said.held_samples, 1990);
+  EXPECT_LT(said.qd.cwiseAbs().maxCoeff(), 1e-5) << said.qd.transpose();
+  EXPECT_LT(said.d.head<3>().cwiseAbs().maxCoeff(), 0.5) << said.d.transpose();
+  // Without the word, the push is predicted and d takes it up.
+  const HeldRun unsaid = RunAtRest(c, true, push_n, false);
+  EXPECT_EQ(unsaid.held_samples, 0);
+  EXPECT_GT(unsaid.d.head<3>().cwiseAbs().maxCoeff(), 1.0) << unsaid.d.transpose();
 }
 
 }  // namespace

@@ -123,6 +123,22 @@ TEST_F(BridgeTest, FreshCommandIsMappedAndStaleOneZeroed) {
   for (int16_t d : f.command.drive) EXPECT_EQ(d, 0);
 }
 
+// A bridge that was not running (SIGSTOP, a starved CPU) reads the device's
+// frames queued meanwhile: against those old samples the command from
+// before the stall looks young, but on the host's clock it is not.
+TEST_F(BridgeTest, AfterAStallAQueuedFrameDoesNotMakeAnOldCommandYoung) {
+  Deliver(0);
+  Deliver(1);
+  ASSERT_EQ(Command(bridge_, sample_.utime, Vector6d::Constant(20.0)), CommandVerdict::kAccepted);
+  Send();
+  EXPECT_EQ(bridge_.last_reason(), DriveReason::kCommand);
+  // Sample 2 was queued 2 s ago; the bridge reads it only now.
+  Deliver(2, 2'000'000);
+  const DecodedFrame f = Send();
+  EXPECT_EQ(bridge_.last_reason(), DriveReason::kStale);
+  for (int16_t d : f.command.drive) EXPECT_EQ(d, 0);
+}
+
 TEST_F(BridgeTest, ForcesInTheDeadZoneAreCounted) {
   // A commanded force the dead zone drops is counted per leg and frame: the
   // rest of the stack assumes the commanded force acts.

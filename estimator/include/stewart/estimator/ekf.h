@@ -46,7 +46,9 @@ class Ekf {
  private:
   bool InitializeFromLegs(const SensorSample& sample, uint32_t* events);
   // `trig`: sines and cosines of the current estimate's Euler angles.
-  void Predict(double dt_s, int64_t utime, const EulerAngleTrig& trig, uint32_t* events);
+  /// `drive_off`: the sample says no drive acted over the interval.
+  void Predict(double dt_s, int64_t utime, const EulerAngleTrig& trig, bool drive_off,
+               uint32_t* events);
   void CorrectLegs(const Vector6d& leg_length_m, const EulerAngleTrig& trig, uint32_t* events);
   void CorrectGyro(const Vector3d& gyro_radps, const EulerAngleTrig& trig, uint32_t* events);
   void CorrectAccel(const Vector3d& accel_mps2, const EulerAngleTrig& trig, uint32_t* events);

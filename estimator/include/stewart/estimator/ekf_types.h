@@ -33,6 +33,10 @@ struct SensorSample {
   /// The source applied the answer to its previous sample over the interval
   /// ending here (sensor_t::STATUS_ANSWER_APPLIED; lockstep plant_sim).
   bool previous_answer_applied = false;
+  /// No drive over the interval ending here: the actuators off or the
+  /// device's watchdog (sensor_t::STATUS_ACTUATORS_OFF, STATUS_DEVICE_WATCHDOG),
+  /// whatever the safe commands said; the lead screws hold the legs.
+  bool drive_off = false;
 };
 
 /// The filter's output for one sample.

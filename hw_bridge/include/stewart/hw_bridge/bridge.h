@@ -205,7 +205,8 @@ class HwBridge {
   }
 
  private:
-  DriveReason CurrentReason() const;
+  /// `host_now_us`: now in the host time base of the samples' utime.
+  DriveReason CurrentReason(int64_t host_now_us) const;
   /// Bit i: leg i's reading is in its calibrated span and not flagged.
   uint8_t PlausibleMask(const SensorFrame& frame) const;
   CommandVerdict AcceptCommand(int64_t utime, bool finite);
