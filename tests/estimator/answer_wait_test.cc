@@ -83,12 +83,29 @@ void Feed(const std::vector<Input>& inputs, const std::vector<int>& overtaken, W
   }
 }
 
-TEST(AnswerWait, AnOvertakenSampleGivesTheEstimateOfTheCausalOrder) {
-  const std::vector<Input> inputs = Inputs();
+class AnswerWait : public ::testing::Test {
+ protected:
+  AnswerWait() : inputs_(Inputs()), process_(MakeProcess(&counters_)) {}
+
+  /// Sample 0 estimated; sample 1, flagged, arrives 1 ms later without the
+  /// answer to sample 0 and waits.
+  void SampleOneWaits() {
+    ASSERT_TRUE(process_.OnSensor(inputs_[0].sample, &out_, kWallUs));
+    EXPECT_FALSE(process_.OnSensor(inputs_[1].sample, &out_, kWallUs + 1000));
+    ASSERT_TRUE(process_.waiting());
+  }
+
+  std::vector<Input> inputs_;
+  HealthCounters counters_{"estimator"};
+  EstimatorProcess process_;
+  StateSample out_;
+};
+
+TEST_F(AnswerWait, AnOvertakenSampleGivesTheEstimateOfTheCausalOrder) {
   WaitRun in_order;
-  Feed(inputs, {}, &in_order);
+  Feed(inputs_, {}, &in_order);
   WaitRun overtaken;
-  Feed(inputs, {3, 150, 151, 152, 300, 420, 599}, &overtaken);
+  Feed(inputs_, {3, 150, 151, 152, 300, 420, 599}, &overtaken);
   ASSERT_EQ(in_order.estimates.size(), overtaken.estimates.size());
   for (size_t i = 0; i < in_order.estimates.size(); ++i) {
     const StateSample& a = in_order.estimates[i];
@@ -103,69 +120,50 @@ TEST(AnswerWait, AnOvertakenSampleGivesTheEstimateOfTheCausalOrder) {
   EXPECT_EQ(in_order.counters.counter("samples_waited_for_answer"), 0);
 }
 
-TEST(AnswerWait, WithoutTheFlagASampleNeverWaits) {
-  std::vector<Input> inputs = Inputs();
-  for (Input& in : inputs) in.sample.previous_answer_applied = false;
-  HealthCounters counters("estimator");
-  EstimatorProcess process = MakeProcess(&counters);
-  StateSample out;
-  ASSERT_TRUE(process.OnSensor(inputs[0].sample, &out, kWallUs));
-  // The answer to sample 0 never comes: sample 1 is estimated at once (a
-  // real-time source applies whatever command it holds).
-  EXPECT_TRUE(process.OnSensor(inputs[1].sample, &out, kWallUs + 1000));
-  EXPECT_FALSE(process.waiting());
+TEST_F(AnswerWait, WithoutTheFlagASampleNeverWaits) {
+  ASSERT_TRUE(process_.OnSensor(inputs_[0].sample, &out_, kWallUs));
+  // The answer to sample 0 never comes: sample 1, not flagged, is estimated
+  // at once (a real-time source applies whatever command it holds).
+  SensorSample one = inputs_[1].sample;
+  one.previous_answer_applied = false;
+  EXPECT_TRUE(process_.OnSensor(one, &out_, kWallUs + 1000));
+  EXPECT_FALSE(process_.waiting());
 }
 
-TEST(AnswerWait, AnAnswerThatNeverComesCostsAtMostTheWaitAndIsCounted) {
-  const std::vector<Input> inputs = Inputs();
-  HealthCounters counters("estimator");
-  EstimatorProcess process = MakeProcess(&counters);
-  StateSample out;
-  ASSERT_TRUE(process.OnSensor(inputs[0].sample, &out, kWallUs));
-  // The answer to sample 0 is lost to this process alone.
+TEST_F(AnswerWait, AnAnswerThatNeverComesCostsAtMostTheWaitAndIsCounted) {
+  SampleOneWaits();  // the answer to sample 0 is lost to this process alone
   const int64_t received = kWallUs + 1000;
-  EXPECT_FALSE(process.OnSensor(inputs[1].sample, &out, received));
   const auto wait_us = static_cast<int64_t>(EstimatorProcess::kAnswerWait_s * 1e6);
-  EXPECT_FALSE(process.FlushWaiting(received + wait_us - 1, &out)) << "flushed before the wait";
-  EXPECT_TRUE(process.waiting());
+  EXPECT_FALSE(process_.FlushWaiting(received + wait_us - 1, &out_)) << "flushed before the wait";
+  EXPECT_TRUE(process_.waiting());
   // A resend of the waiting sample (lockstep) does not end the wait either.
-  EXPECT_FALSE(process.OnSensor(inputs[1].sample, &out, received + 100));
-  ASSERT_TRUE(process.FlushWaiting(received + wait_us, &out));
-  EXPECT_EQ(out.utime, inputs[1].sample.utime);
-  EXPECT_FALSE(process.waiting());
-  EXPECT_EQ(counters.counter("answer_not_heard"), 1);
+  EXPECT_FALSE(process_.OnSensor(inputs_[1].sample, &out_, received + 100));
+  ASSERT_TRUE(process_.FlushWaiting(received + wait_us, &out_));
+  EXPECT_EQ(out_.utime, inputs_[1].sample.utime);
+  EXPECT_FALSE(process_.waiting());
+  EXPECT_EQ(counters_.counter("answer_not_heard"), 1);
 }
 
-TEST(AnswerWait, ANewerSampleEndsTheWaitAndIsTheOneEstimated) {
-  const std::vector<Input> inputs = Inputs();
-  HealthCounters counters("estimator");
-  EstimatorProcess process = MakeProcess(&counters);
-  StateSample out;
-  ASSERT_TRUE(process.OnSensor(inputs[0].sample, &out, kWallUs));
-  EXPECT_FALSE(process.OnSensor(inputs[1].sample, &out, kWallUs + 1000));
+TEST_F(AnswerWait, ANewerSampleEndsTheWaitAndIsTheOneEstimated) {
+  SampleOneWaits();
   // Sample 2 without the flag: the source moved on without the answer.
-  SensorSample next = inputs[2].sample;
+  SensorSample next = inputs_[2].sample;
   next.previous_answer_applied = false;
-  ASSERT_TRUE(process.OnSensor(next, &out, kWallUs + 2000));
-  EXPECT_EQ(out.utime, next.utime);
-  EXPECT_FALSE(process.waiting());
-  EXPECT_EQ(counters.counter("answer_not_heard"), 1);
+  ASSERT_TRUE(process_.OnSensor(next, &out_, kWallUs + 2000));
+  EXPECT_EQ(out_.utime, next.utime);
+  EXPECT_FALSE(process_.waiting());
+  EXPECT_EQ(counters_.counter("answer_not_heard"), 1);
 }
 
-TEST(AnswerWait, ARejectedAnswerStillEndsTheWait) {
-  const std::vector<Input> inputs = Inputs();
-  HealthCounters counters("estimator");
-  EstimatorProcess process = MakeProcess(&counters);
-  StateSample out;
-  ASSERT_TRUE(process.OnSensor(inputs[0].sample, &out, kWallUs));
-  EXPECT_FALSE(process.OnSensor(inputs[1].sample, &out, kWallUs + 1000));
-  ForceCommand poisoned = inputs[0].answer;
+TEST_F(AnswerWait, ARejectedAnswerStillEndsTheWait) {
+  SampleOneWaits();
+  ForceCommand poisoned = inputs_[0].answer;
   poisoned.force_n(2) = std::numeric_limits<double>::quiet_NaN();
   // The answer came (and was refused): the sample waits no longer.
-  ASSERT_TRUE(process.OnCommand(poisoned, &out, kWallUs + 1100));
-  EXPECT_EQ(out.utime, inputs[1].sample.utime);
-  EXPECT_TRUE(out.q.allFinite());
-  EXPECT_EQ(counters.counter("rejected_command_non_finite"), 1);
+  ASSERT_TRUE(process_.OnCommand(poisoned, &out_, kWallUs + 1100));
+  EXPECT_EQ(out_.utime, inputs_[1].sample.utime);
+  EXPECT_TRUE(out_.q.allFinite());
+  EXPECT_EQ(counters_.counter("rejected_command_non_finite"), 1);
 }
 
 }  // namespace
