@@ -293,12 +293,11 @@ void PlantSimNode::UpdateTickCounters() {
 }
 
 void PlantSimNode::ApplyRealTimeDecision() {
-  // Now on the plant's clock: behind its schedule, the tick's sample time
-  // lags the time that passed (RealTimeCommandHold::Decide).
-  const int64_t now_utime =
-      utime0_ +
-      std::chrono::duration_cast<std::chrono::microseconds>(Clock::now() - rt_start_).count();
-  const RealTimeCommandHold::Decision d = hold_.Decide(tick_utime_, now_utime);
+  // Judged on the tick's sample time only: counting the plant's own
+  // lateness too (a simulator behind its schedule) turned the actuators off
+  // on a congested link whenever the loop's CPU was busy (docs/operations.md,
+  // "Several hosts").
+  const RealTimeCommandHold::Decision d = hold_.Decide(tick_utime_, tick_utime_);
   const bool off = d.actuators_off || guard_.tripped();
   plant_.SetActuatorsOff(off);
   if (!off) {
@@ -329,8 +328,7 @@ ExitCode PlantSimNode::RunRealTime() {
   latency_tracker_ = LoopLatencyTracker(utime0_, period_us_);
   tick_accounting_ = TickAccounting(utime0_, period_us_);
   UpdateTickCounters();
-  rt_start_ = Clock::now();
-  const RealTimePacing pacing(period_us_, rt_start_);
+  const RealTimePacing pacing(period_us_, Clock::now());
   for (tick_ = 0;; ++tick_) {
     const Clock::time_point deadline = pacing.Deadline(tick_);
     while (!StopRequested()) {

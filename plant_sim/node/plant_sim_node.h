@@ -97,8 +97,6 @@ class PlantSimNode {
   /// Lockstep: the period before the next sample applied the answer to the
   /// sample before it (sensor_t::STATUS_ANSWER_APPLIED).
   bool answer_applied_ = false;
-  /// Real time: when tick 0 was due (utime0_ on the plant's clock).
-  std::chrono::steady_clock::time_point rt_start_{};
   CommandGate gate_;
   LoopLatencyTracker latency_tracker_;
   TickAccounting tick_accounting_;

@@ -215,7 +215,9 @@ TEST(PlantSimTrust, LockstepForgeriesWithoutTheSessionOrSeqAreDropped) {
   ASSERT_FALSE(bus.health.empty());
   const health_t& h = bus.last_health();
   EXPECT_GE(Counter(h, "rejected_command_wrong_session"), 2 * 500);
-  EXPECT_GE(Counter(h, "rejected_command_seq_not_increasing"), 500);
+  // The copy after the last answer (sample 499) races the plant's exit
+  // after its last sample: it may come after the final heartbeat.
+  EXPECT_GE(Counter(h, "rejected_command_seq_not_increasing"), 499);
   EXPECT_GE(Counter(h, "rejected_supervisor_session_busy"), 5);
   EXPECT_EQ(Counter(h, "guard_trips"), 0);
   EXPECT_EQ(Counter(h, "sessions_adopted"), 1);
