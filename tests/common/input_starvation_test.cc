@@ -2,18 +2,20 @@
 
 #include <gtest/gtest.h>
 
+#include "stewart/test_support/test_clock.h"
+
 namespace stewart {
 namespace {
 
-constexpr int64_t kMs = 1000;
-constexpr int64_t kWall = 1'780'000'000'000'000;
+using ::stewart::test::kMsUs;
+using ::stewart::test::kWallUs;
 
 TEST(InputStarvation, RejectionsLongerThanTheStaleAgeOnTheWallClock) {
   InputStarvation s(0.02, 1.0);
-  EXPECT_FALSE(s.OnRejected(0, kWall));
-  EXPECT_FALSE(s.OnRejected(kMs, kWall + 10 * kMs));
-  EXPECT_FALSE(s.OnRejected(2 * kMs, kWall + 20 * kMs));  // not longer than 20 ms
-  EXPECT_TRUE(s.OnRejected(3 * kMs, kWall + 21 * kMs));
+  EXPECT_FALSE(s.OnRejected(0, kWallUs));
+  EXPECT_FALSE(s.OnRejected(kMsUs, kWallUs + 10 * kMsUs));
+  EXPECT_FALSE(s.OnRejected(2 * kMsUs, kWallUs + 20 * kMsUs));  // not longer than 20 ms
+  EXPECT_TRUE(s.OnRejected(3 * kMsUs, kWallUs + 21 * kMsUs));
   EXPECT_TRUE(s.starved());
   EXPECT_TRUE(s.OnAccepted());  // ended it
   EXPECT_FALSE(s.starved());
@@ -25,22 +27,22 @@ TEST(InputStarvation, OneRejectionAfterASilenceIsNotStarvation) {
   s.OnAccepted();
   // Seconds without input, then one forged message: nothing says the
   // receiver rejects a stream.
-  EXPECT_FALSE(s.OnRejected(8'000'000'000'000'000'000, kWall + 5'000 * kMs));
+  EXPECT_FALSE(s.OnRejected(8'000'000'000'000'000'000, kWallUs + 5'000 * kMsUs));
   EXPECT_FALSE(s.starved());
 }
 
 TEST(InputStarvation, AnAcceptedMessageRestartsTheCount) {
   InputStarvation s(0.02, 1.0);
-  EXPECT_FALSE(s.OnRejected(0, kWall));
+  EXPECT_FALSE(s.OnRejected(0, kWallUs));
   s.OnAccepted();
-  EXPECT_FALSE(s.OnRejected(kMs, kWall + 15 * kMs));
-  EXPECT_FALSE(s.OnRejected(2 * kMs, kWall + 30 * kMs));  // 15 ms since this run began
+  EXPECT_FALSE(s.OnRejected(kMsUs, kWallUs + 15 * kMsUs));
+  EXPECT_FALSE(s.OnRejected(2 * kMsUs, kWallUs + 30 * kMsUs));  // 15 ms since this run began
 }
 
 TEST(InputStarvation, WithoutReceiveTimesAConsistentStreamOfRejectedTimes) {
   InputStarvation s(0.02, 1.0);
-  for (int64_t k = 0; k <= 20; ++k) EXPECT_FALSE(s.OnRejected(k * kMs, std::nullopt)) << k;
-  EXPECT_TRUE(s.OnRejected(21 * kMs, std::nullopt));
+  for (int64_t k = 0; k <= 20; ++k) EXPECT_FALSE(s.OnRejected(k * kMsUs, std::nullopt)) << k;
+  EXPECT_TRUE(s.OnRejected(21 * kMsUs, std::nullopt));
 }
 
 TEST(InputStarvation, WithoutReceiveTimesFarOffMessagesNeverMakeAStream) {
@@ -48,7 +50,7 @@ TEST(InputStarvation, WithoutReceiveTimesFarOffMessagesNeverMakeAStream) {
   // A forged time and a real one alternate: no run of consistent times
   // spans the stale age, so one forged message never starves a receiver.
   for (int64_t k = 0; k < 100; ++k) {
-    EXPECT_FALSE(s.OnRejected(k % 2 ? 8'000'000'000'000'000'000 : k * kMs, std::nullopt)) << k;
+    EXPECT_FALSE(s.OnRejected(k % 2 ? 8'000'000'000'000'000'000 : k * kMsUs, std::nullopt)) << k;
   }
 }
 

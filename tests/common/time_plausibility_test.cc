@@ -5,11 +5,14 @@
 #include <limits>
 #include <stdexcept>
 
+#include "stewart/test_support/test_clock.h"
+
 namespace stewart {
 namespace {
 
-constexpr int64_t kS = 1'000'000;              // us per s
-constexpr int64_t kWall = 1'780'000'000 * kS;  // a wall clock in 2026, us since the epoch
+using ::stewart::test::kWallUs;
+
+constexpr int64_t kS = 1'000'000;  // us per s
 const TimePlausibilityParams kParams{1.0, 100.0};
 
 TEST(TimePlausibility, FirstMessageAnchorsWithoutReceiveTime) {
@@ -39,11 +42,11 @@ TEST(TimePlausibility, WindowAroundTheNewestAcceptedTime) {
 
 TEST(TimePlausibility, ExtremeTimesDoNotOverflow) {
   TimePlausibility p(kParams);
-  p.Accept(-5 * kS, kWall);
-  EXPECT_EQ(p.Check(std::numeric_limits<int64_t>::max(), kWall), TimeVerdict::kAheadOfWallClock);
+  p.Accept(-5 * kS, kWallUs);
+  EXPECT_EQ(p.Check(std::numeric_limits<int64_t>::max(), kWallUs), TimeVerdict::kAheadOfWallClock);
   EXPECT_EQ(p.Check(std::numeric_limits<int64_t>::max(), std::nullopt),
             TimeVerdict::kAheadOfWindow);
-  EXPECT_EQ(p.Check(std::numeric_limits<int64_t>::min(), kWall), TimeVerdict::kBehindWindow);
+  EXPECT_EQ(p.Check(std::numeric_limits<int64_t>::min(), kWallUs), TimeVerdict::kBehindWindow);
   TimePlausibility late(kParams);
   late.Accept(std::numeric_limits<int64_t>::max() - 10, std::nullopt);
   EXPECT_EQ(late.Check(std::numeric_limits<int64_t>::min(), std::nullopt),
@@ -70,31 +73,31 @@ TEST(TimePlausibility, StackTimeAheadOfTheWallClockIsNeverPlausible) {
   TimePlausibility p(kParams);
   // Before anything was accepted: real time starts at the wall clock,
   // lockstep at 0; neither is ahead of the receive time.
-  EXPECT_EQ(p.Check(kWall - 3 * kS, kWall), TimeVerdict::kPlausible);
-  EXPECT_EQ(p.Check(0, kWall), TimeVerdict::kPlausible);
-  EXPECT_EQ(p.Check(kWall + 2 * kS, kWall), TimeVerdict::kAheadOfWallClock);
-  EXPECT_EQ(p.Check(8'000'000'000'000'000'000, kWall), TimeVerdict::kAheadOfWallClock);
+  EXPECT_EQ(p.Check(kWallUs - 3 * kS, kWallUs), TimeVerdict::kPlausible);
+  EXPECT_EQ(p.Check(0, kWallUs), TimeVerdict::kPlausible);
+  EXPECT_EQ(p.Check(kWallUs + 2 * kS, kWallUs), TimeVerdict::kAheadOfWallClock);
+  EXPECT_EQ(p.Check(8'000'000'000'000'000'000, kWallUs), TimeVerdict::kAheadOfWallClock);
 }
 
 TEST(TimePlausibility, LockstepRunsFasterThanTheWallClock) {
   // Lockstep at 50x: after 0.1 s of wall time without a message, stack time
   // may have moved 5 s, beyond the window but within 100x.
   TimePlausibility p(kParams);
-  p.Accept(20 * kS, kWall);
-  EXPECT_EQ(p.Check(25 * kS, kWall + kS / 10), TimeVerdict::kPlausible);
-  EXPECT_EQ(p.Check(20 * kS + 12 * kS, kWall + kS / 10), TimeVerdict::kAheadOfWindow);
+  p.Accept(20 * kS, kWallUs);
+  EXPECT_EQ(p.Check(25 * kS, kWallUs + kS / 10), TimeVerdict::kPlausible);
+  EXPECT_EQ(p.Check(20 * kS + 12 * kS, kWallUs + kS / 10), TimeVerdict::kAheadOfWindow);
   // A message 1e12 us ahead 1 ms after the newest: far beyond any rate.
-  EXPECT_EQ(p.Check(20 * kS + 1'000'000'000'000, kWall + 1000), TimeVerdict::kAheadOfWindow);
+  EXPECT_EQ(p.Check(20 * kS + 1'000'000'000'000, kWallUs + 1000), TimeVerdict::kAheadOfWindow);
   // Without receive times (replay) only the window counts.
   EXPECT_EQ(p.Check(25 * kS, std::nullopt), TimeVerdict::kAheadOfWindow);
 }
 
 TEST(TimePlausibility, RealTimePlantRestartIsFollowed) {
-  // plant_sim in real time stopped at wall time kWall and started again 30 s
+  // plant_sim in real time stopped at wall time kWallUs and started again 30 s
   // later: its new stack time is the new wall clock.
   TimePlausibility p(kParams);
-  p.Accept(kWall - 2000, kWall);
-  const int64_t restart_wall = kWall + 30 * kS;
+  p.Accept(kWallUs - 2000, kWallUs);
+  const int64_t restart_wall = kWallUs + 30 * kS;
   EXPECT_EQ(p.Check(restart_wall - 1000, restart_wall), TimeVerdict::kPlausible);
   // Ahead of the wall clock it is not, however long the silence was.
   EXPECT_EQ(p.Check(restart_wall + 5 * kS, restart_wall), TimeVerdict::kAheadOfWallClock);

@@ -13,12 +13,14 @@
 #include "scenario_truth.h"
 #include "stewart/config/default_config.h"
 #include "stewart/estimator/estimator_process.h"
+#include "stewart/test_support/test_clock.h"
 
 namespace stewart {
 namespace {
 
+using ::stewart::test::kWallUs;
+
 constexpr int kSamples = 600;
-constexpr int64_t kWallUs = 1'780'000'000'000'000;
 
 struct Input {
   SensorSample sample;

@@ -21,10 +21,6 @@ constexpr Bounds kConstantVelocityBounds{1e-4, 1e-4, 1e-3, 1e-3};
 // (0.3 mrad/s before): docs/estimator.md, "Model error".
 constexpr Bounds kDynamicsBounds{5e-5, 5e-5, 4e-4, 7e-4};
 
-Ekf MakeEkf(const StackConfig& c) {
-  return Ekf(c.platform, c.actuators, c.sensors, c.estimator, c.home_pose);
-}
-
 void Print(const char* name, const RunStats& s) {
   const Vector6d q = s.q_err.Rms(), qd = s.qd_err.Rms();
   std::printf("%-26s q [mm, mrad]     %6.3f %6.3f %6.3f | %6.3f %6.3f %6.3f\n", name, 1e3 * q(0),

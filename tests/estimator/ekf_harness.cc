@@ -22,6 +22,10 @@ const StackConfig& EstimatorTestConfig() {
   return config;
 }
 
+Ekf MakeEkf(const StackConfig& c) {
+  return Ekf(c.platform, c.actuators, c.sensors, c.estimator, c.home_pose);
+}
+
 RunStats RunScenario(const StackConfig& config, unsigned seed, double t_end_s, double settle_s,
                      Ekf* ekf, const RunHooks& hooks, const TruthDisturbance& disturbance) {
   ScenarioTruth truth(config, seed, true, disturbance);

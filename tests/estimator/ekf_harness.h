@@ -31,4 +31,7 @@ RunStats RunScenario(const StackConfig& config, unsigned seed, double t_end_s, d
 
 const StackConfig& EstimatorTestConfig();
 
+/// The EKF the estimator process builds from `c`, started at its home pose.
+Ekf MakeEkf(const StackConfig& c);
+
 }  // namespace stewart::test

@@ -18,10 +18,6 @@ namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-Ekf MakeEkf(const StackConfig& c) {
-  return Ekf(c.platform, c.actuators, c.sensors, c.estimator, c.home_pose);
-}
-
 // The default model's accuracy bounds (docs/estimator.md).
 void ExpectAccurate(const RunStats& s) {
   const Vector6d q = s.q_err.Rms(), qd = s.qd_err.Rms();

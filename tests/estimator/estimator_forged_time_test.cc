@@ -14,11 +14,13 @@
 #include "scenario_truth.h"
 #include "stewart/config/default_config.h"
 #include "stewart/estimator/estimator_process.h"
+#include "stewart/test_support/test_clock.h"
 
 namespace stewart {
 namespace {
 
-constexpr int64_t kWall = 1'780'000'000'000'000;
+using ::stewart::test::kWallUs;
+
 constexpr int64_t kForgedUtime = 8'000'000'000'000'000'000;
 
 struct ProcessRun {
@@ -37,7 +39,7 @@ void RunProcess(int n, bool live, bool forge, ProcessRun* run) {
   for (int k = 0; k < n; ++k) {
     const test::TruthSample sample = truth.Next();
     const std::optional<int64_t> wall =
-        live ? std::optional<int64_t>(kWall + sample.utime) : std::nullopt;
+        live ? std::optional<int64_t>(kWallUs + sample.utime) : std::nullopt;
     StateSample out;
     if (forge && k == 300) {
       SensorSample ahead = sample.sensors;
@@ -101,7 +103,7 @@ void RunWithResend(int n, bool live, int resend_at, ProcessRun* run, int* copies
     test::TruthSample sample = truth.Next();
     sample.sensors.seq = k;
     const std::optional<int64_t> wall =
-        live ? std::optional<int64_t>(kWall + sample.utime) : std::nullopt;
+        live ? std::optional<int64_t>(kWallUs + sample.utime) : std::nullopt;
     StateSample out;
     if (process.OnSensor(sample.sensors, &out, wall)) run->estimates.push_back(out);
     if (k == resend_at) {

@@ -10,12 +10,14 @@
 #include "stewart/config/default_config.h"
 #include "stewart/estimator/estimator_process.h"
 #include "stewart/guard/guard_limits.h"
+#include "stewart/test_support/test_clock.h"
 
 namespace stewart {
 namespace {
 
+using ::stewart::test::kWallUs;
+
 constexpr int64_t kSession = 77;
-constexpr int64_t kWallUs = 1'780'000'000'000'000;
 
 struct EstimatorRun {
   std::vector<StateSample> estimates;

@@ -125,7 +125,7 @@ TEST(CommandSessionCheck, RemembersTheLastFourSessions) {
 
 /// Remembers the drive; reads legs standing still mid-stroke (plausible to
 /// the bridge's guard).
-class RecordingBackend : public DeviceBackend {
+class StillLegsBackend : public DeviceBackend {
  public:
   void Step(const DriveArray& drive, double) override { last = drive; }
   RawReadings Sample() override {
@@ -141,7 +141,7 @@ class RecordingBackend : public DeviceBackend {
 // WATCHDOG on every remaining sample, because the new bridge's seq starts
 // again at 1 and the device dropped every frame as "not newer".
 TEST(DeviceSession, ARestartedBridgeIsFollowedAndTheOldOnesLateFrameIsNot) {
-  RecordingBackend backend;
+  StillLegsBackend backend;
   DeviceEmulator device(&backend);
   constexpr uint32_t kWatchdogUs = 50000;
   uint64_t t = 1000;
@@ -195,7 +195,7 @@ TEST(DeviceSession, TheNextBridgeTakesOverOnlyOnceTheFirstIsGone) {
   };
   HwBridge first = make_bridge();
   HwBridge second = make_bridge();
-  RecordingBackend backend;
+  StillLegsBackend backend;
   DeviceEmulator device(&backend);
   constexpr int64_t kSafetySession = 9;
   constexpr int64_t kHostEpochUs = 1'000'000'000'000;

@@ -251,7 +251,7 @@ void ExpectBridgePlusEmulatorEqualsPlantSim(const StackConfig& c, const SwapCont
   HwBridge bridge(c.hw_bridge, c.platform.leg_min_length_m,
                   c.platform.leg_max_length_m - c.platform.leg_min_length_m,
                   c.actuators.force_limit_n, {}, c.guard);
-  constexpr int64_t kSession = 5;  // the safety session the commands come from
+  constexpr int64_t kSafetySession = 5;  // the safety session the commands come from
   // plant_sim's library, as its node uses it (legs locked until the first command).
   OdeOptions ode;
   ode.rel_tol = c.plant_sim.rel_tol;
@@ -323,14 +323,14 @@ void ExpectBridgePlusEmulatorEqualsPlantSim(const StackConfig& c, const SwapCont
     const Vector6d f_sim = control(plant.q(), plant.qd(), t_s);
     min_force = std::min(min_force, f_emu.cwiseAbs().minCoeff());
     if (k == 0) {
-      ASSERT_EQ(bridge.OnAnnouncement({sample.utime, 1, kSession}, true, 0),
+      ASSERT_EQ(bridge.OnAnnouncement({sample.utime, 1, kSafetySession}, true, 0),
                 AnnouncementVerdict::kAdopted);
     }
     ForceCommand command_emu;
     command_emu.utime = command_emu.sample_utime = sample.utime;
     command_emu.seq = k;
     command_emu.force_n = f_emu;
-    command_emu.session_id = kSession;
+    command_emu.session_id = kSafetySession;
     ASSERT_EQ(bridge.OnSafeCommand(command_emu, true), CommandVerdict::kAccepted);
     std::array<uint8_t, kMaxFrameSize> buffer{};
     const std::size_t size = bridge.BuildCommandFrame(sample.utime, buffer.data());

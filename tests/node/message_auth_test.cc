@@ -9,15 +9,12 @@
 
 #include "stewart/force_command_t.hpp"
 #include "stewart/operator_command_t.hpp"
+#include "stewart/test_support/test_key.h"
 
 namespace stewart {
 namespace {
 
-std::vector<uint8_t> Key(uint8_t seed) {
-  std::vector<uint8_t> key(32);
-  for (size_t i = 0; i < key.size(); ++i) key[i] = static_cast<uint8_t>(seed + 7 * i);
-  return key;
-}
+using ::stewart::test::TestKey;
 
 force_command_t Command() {
   force_command_t c{};
@@ -30,7 +27,7 @@ force_command_t Command() {
 }
 
 TEST(MessageAuth, SignedMessageVerifiesAndAnyChangeDoesNot) {
-  MessageAuthenticator auth(Key(1));
+  MessageAuthenticator auth(TestKey(1));
   force_command_t c = Command();
   auth.Sign(&c);
   EXPECT_TRUE(auth.Verify(c));
@@ -43,12 +40,12 @@ TEST(MessageAuth, SignedMessageVerifiesAndAnyChangeDoesNot) {
   forged = c;
   forged.mac[0] ^= 1;
   EXPECT_FALSE(auth.Verify(forged));
-  MessageAuthenticator other(Key(2));
+  MessageAuthenticator other(TestKey(2));
   EXPECT_FALSE(other.Verify(c));
 }
 
 TEST(MessageAuth, StringFieldsAreCovered) {
-  MessageAuthenticator auth(Key(3));
+  MessageAuthenticator auth(TestKey(3));
   operator_command_t o{};
   o.operator_id = 7;
   o.command = operator_command_t::COMMAND_ARM;
@@ -67,7 +64,7 @@ TEST(MessageAuth, DisabledSignsZeroAndAcceptsAll) {
   for (int8_t b : c.mac) EXPECT_EQ(b, 0);
   EXPECT_TRUE(off.Verify(c));
   // A receiver with a key rejects the unsigned message.
-  MessageAuthenticator on(Key(1));
+  MessageAuthenticator on(TestKey(1));
   EXPECT_FALSE(on.Verify(c));
 }
 

@@ -7,16 +7,15 @@
 
 #include <vector>
 
+#include "stewart/test_support/test_clock.h"
+#include "stewart/test_support/test_key.h"
+
 namespace stewart {
 namespace {
 
-constexpr int64_t kWall = 1'780'000'000'000'000;  // us since the epoch
+using ::stewart::test::kWallUs;
 
-std::vector<uint8_t> Key(uint8_t seed) {
-  std::vector<uint8_t> key(32);
-  for (size_t i = 0; i < key.size(); ++i) key[i] = static_cast<uint8_t>(seed + 5 * i);
-  return key;
-}
+using ::stewart::test::TestKey;
 
 operator_command_t Reset(int64_t operator_id, int64_t seq, int64_t utime) {
   operator_command_t o{};
@@ -29,63 +28,63 @@ operator_command_t Reset(int64_t operator_id, int64_t seq, int64_t utime) {
 }
 
 TEST(OperatorResetFilter, SignedFreshResetIsAccepted) {
-  MessageAuthenticator signer(Key(1));
-  OperatorResetFilter filter(MessageAuthenticator(Key(1)), 1.0);
-  operator_command_t reset = Reset(42, 1, kWall);
+  MessageAuthenticator signer(TestKey(1));
+  OperatorResetFilter filter(MessageAuthenticator(TestKey(1)), 1.0);
+  operator_command_t reset = Reset(42, 1, kWallUs);
   signer.Sign(&reset);
-  EXPECT_TRUE(filter.OnCommand(reset, kWall + 2000));
+  EXPECT_TRUE(filter.OnCommand(reset, kWallUs + 2000));
   EXPECT_EQ(filter.counts().accepted, 1);
 }
 
 TEST(OperatorResetFilter, RejectsWhatCouldNotBeTheOperatorsFreshReset) {
-  MessageAuthenticator signer(Key(1));
-  OperatorResetFilter filter(MessageAuthenticator(Key(1)), 1.0);
+  MessageAuthenticator signer(TestKey(1));
+  OperatorResetFilter filter(MessageAuthenticator(TestKey(1)), 1.0);
 
-  operator_command_t wrong_key = Reset(42, 1, kWall);
-  MessageAuthenticator(Key(2)).Sign(&wrong_key);
-  EXPECT_FALSE(filter.OnCommand(wrong_key, kWall));
+  operator_command_t wrong_key = Reset(42, 1, kWallUs);
+  MessageAuthenticator(TestKey(2)).Sign(&wrong_key);
+  EXPECT_FALSE(filter.OnCommand(wrong_key, kWallUs));
   EXPECT_EQ(filter.counts().rejected_auth, 1);
 
-  operator_command_t old = Reset(42, 2, kWall - 5'000'000);  // 5 s old
+  operator_command_t old = Reset(42, 2, kWallUs - 5'000'000);  // 5 s old
   signer.Sign(&old);
-  EXPECT_FALSE(filter.OnCommand(old, kWall));
-  operator_command_t ahead = Reset(42, 3, kWall + 5'000'000);
+  EXPECT_FALSE(filter.OnCommand(old, kWallUs));
+  operator_command_t ahead = Reset(42, 3, kWallUs + 5'000'000);
   signer.Sign(&ahead);
-  EXPECT_FALSE(filter.OnCommand(ahead, kWall));
+  EXPECT_FALSE(filter.OnCommand(ahead, kWallUs));
   EXPECT_EQ(filter.counts().rejected_time, 2);
 
-  operator_command_t fresh = Reset(42, 10, kWall);
+  operator_command_t fresh = Reset(42, 10, kWallUs);
   signer.Sign(&fresh);
-  EXPECT_TRUE(filter.OnCommand(fresh, kWall));
-  EXPECT_FALSE(filter.OnCommand(fresh, kWall + 1000));  // played back
-  operator_command_t older_seq = Reset(42, 9, kWall);
+  EXPECT_TRUE(filter.OnCommand(fresh, kWallUs));
+  EXPECT_FALSE(filter.OnCommand(fresh, kWallUs + 1000));  // played back
+  operator_command_t older_seq = Reset(42, 9, kWallUs);
   signer.Sign(&older_seq);
-  EXPECT_FALSE(filter.OnCommand(older_seq, kWall + 1000));
+  EXPECT_FALSE(filter.OnCommand(older_seq, kWallUs + 1000));
   EXPECT_EQ(filter.counts().rejected_replay, 2);
 
-  operator_command_t no_operator = Reset(0, 1, kWall);
+  operator_command_t no_operator = Reset(0, 1, kWallUs);
   signer.Sign(&no_operator);
-  EXPECT_FALSE(filter.OnCommand(no_operator, kWall));
+  EXPECT_FALSE(filter.OnCommand(no_operator, kWallUs));
   EXPECT_EQ(filter.counts().rejected_invalid, 1);
 
   // Another operator's seq is its own.
-  operator_command_t other = Reset(43, 1, kWall);
+  operator_command_t other = Reset(43, 1, kWallUs);
   signer.Sign(&other);
-  EXPECT_TRUE(filter.OnCommand(other, kWall));
+  EXPECT_TRUE(filter.OnCommand(other, kWallUs));
   EXPECT_EQ(filter.counts().accepted, 2);
 }
 
 TEST(OperatorResetFilter, OnlyResetAcknowledges) {
-  MessageAuthenticator signer(Key(1));
-  OperatorResetFilter filter(MessageAuthenticator(Key(1)), 1.0);
+  MessageAuthenticator signer(TestKey(1));
+  OperatorResetFilter filter(MessageAuthenticator(TestKey(1)), 1.0);
   for (const int8_t command :
        {operator_command_t::COMMAND_ARM, operator_command_t::COMMAND_HOLD,
         operator_command_t::COMMAND_RESUME, operator_command_t::COMMAND_ESTOP,
         operator_command_t::COMMAND_HEARTBEAT}) {
-    operator_command_t o = Reset(42, command, kWall);
+    operator_command_t o = Reset(42, command, kWallUs);
     o.command = command;
     signer.Sign(&o);
-    EXPECT_FALSE(filter.OnCommand(o, kWall)) << int{command};
+    EXPECT_FALSE(filter.OnCommand(o, kWallUs)) << int{command};
   }
   EXPECT_EQ(filter.counts().accepted, 0);
   EXPECT_EQ(filter.counts().rejected_auth + filter.counts().rejected_time +
@@ -95,7 +94,7 @@ TEST(OperatorResetFilter, OnlyResetAcknowledges) {
 
 TEST(OperatorResetFilter, WithoutAKeyEveryTagVerifies) {
   OperatorResetFilter filter(MessageAuthenticator(), 1.0);
-  EXPECT_TRUE(filter.OnCommand(Reset(42, 1, kWall), kWall));
+  EXPECT_TRUE(filter.OnCommand(Reset(42, 1, kWallUs), kWallUs));
 }
 
 }  // namespace

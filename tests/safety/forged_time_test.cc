@@ -14,9 +14,12 @@
 #include "safety_test_support.h"
 #include "stewart/common/health_counters.h"
 #include "stewart/safety/safety_process.h"
+#include "stewart/test_support/test_clock.h"
 
 namespace stewart::safety::test {
 namespace {
+
+using ::stewart::test::kWallUs;
 
 // Armed at the first filtered step: these tests are about message times.
 SupervisorConfig Armed() {
@@ -27,15 +30,14 @@ SupervisorConfig Armed() {
 }
 
 constexpr int64_t kStartUtime = 1'000'000;
-constexpr int64_t kPeriodUs = 1000;
-constexpr int64_t kWall = 1'780'000'000'000'000;  // us since the epoch
+constexpr int64_t kSamplePeriodUs = 1000;
 constexpr int64_t kForgedUtime = 8'000'000'000'000'000'000;
 
-struct Answer {
+struct TimedAnswer {
   int64_t sample_utime;
   Vector6d force_n;
   int32_t flags;
-  bool operator==(const Answer& o) const {
+  bool operator==(const TimedAnswer& o) const {
     return sample_utime == o.sample_utime && force_n == o.force_n && flags == o.flags;
   }
 };
@@ -60,7 +62,7 @@ ForceCommand NominalFor(int64_t sample_utime) {
 /// state. With `live`, every message has a receive time (the wall clock
 /// advancing with stack time, as in real time); without, none (replay).
 struct ProcessRun {
-  std::vector<Answer> answers;
+  std::vector<TimedAnswer> answers;
   HealthCounters counters{"safety"};
 };
 void RunProcess(int n, int controller_stops_at, bool live,
@@ -71,9 +73,9 @@ void RunProcess(int n, int controller_stops_at, bool live,
                         c.lcm.time_plausibility);
   SafetyOutput out;
   for (int k = 0; k < n; ++k) {
-    const int64_t utime = kStartUtime + k * kPeriodUs;
+    const int64_t utime = kStartUtime + k * kSamplePeriodUs;
     const std::optional<int64_t> wall =
-        live ? std::optional<int64_t>(kWall + k * kPeriodUs) : std::nullopt;
+        live ? std::optional<int64_t>(kWallUs + k * kSamplePeriodUs) : std::nullopt;
     if (inject) inject(k, process, wall);
     if (process.OnState(StateAt(utime), &out, wall)) {
       run->answers.push_back({out.command.sample_utime, out.command.force_n, out.command.flags});
@@ -123,7 +125,7 @@ TEST_P(SafetyForgedTime, FarFutureNominalDoesNotDisableTheWatchdog) {
       [&](int k, SafetyProcess& p, std::optional<int64_t> wall) {
         if (k != 55) return;
         SafetyOutput out;
-        const int64_t ahead = kStartUtime + k * kPeriodUs + 1'000'000'000'000;
+        const int64_t ahead = kStartUtime + k * kSamplePeriodUs + 1'000'000'000'000;
         EXPECT_FALSE(p.OnNominal(NominalFor(ahead), &out, wall));
       },
       &attacked);
@@ -134,10 +136,10 @@ TEST_P(SafetyForgedTime, FarFutureNominalDoesNotDisableTheWatchdog) {
   }
   // The watchdog: stale-input fallbacks from stale_age_s after the last
   // nominal command on, for every later state.
-  const int64_t last_nominal = kStartUtime + (kControllerStops - 1) * kPeriodUs;
+  const int64_t last_nominal = kStartUtime + (kControllerStops - 1) * kSamplePeriodUs;
   int fallbacks = 0;
-  for (const Answer& a : attacked.answers) {
-    if (a.sample_utime - last_nominal > stale_us + kPeriodUs) {
+  for (const TimedAnswer& a : attacked.answers) {
+    if (a.sample_utime - last_nominal > stale_us + kSamplePeriodUs) {
       EXPECT_TRUE(a.flags & kCommandStaleInput) << a.sample_utime;
       ++fallbacks;
     }
@@ -156,7 +158,8 @@ TEST_P(SafetyForgedTime, NominalAheadOfEveryStateWithinTheWindowCannotHoldTheWat
       [&](int k, SafetyProcess& p, std::optional<int64_t> wall) {
         if (k != 55) return;
         SafetyOutput out;
-        EXPECT_FALSE(p.OnNominal(NominalFor(kStartUtime + k * kPeriodUs + 500'000), &out, wall));
+        EXPECT_FALSE(
+            p.OnNominal(NominalFor(kStartUtime + k * kSamplePeriodUs + 500'000), &out, wall));
       },
       &attacked);
   EXPECT_EQ(attacked.counters.counter("rejected_nominal_time_implausible"), 0);
@@ -181,20 +184,20 @@ TEST(SafetyForgedTime, RejectingEveryStateIsAFaultThatLatchesAndRecovers) {
   SafetyProcess process(c.platform, c.safety, c.actuators, Armed(), nullptr, &counters,
                         c.lcm.time_plausibility);
   SafetyOutput out;
-  int64_t wall = kWall;
+  int64_t wall = kWallUs;
   const auto state_then_nominal = [&](int64_t utime) {
-    wall += kPeriodUs;
+    wall += kSamplePeriodUs;
     const bool answered = process.OnState(StateAt(utime), &out, wall);
     return process.OnNominal(NominalFor(utime), &out, wall) || answered;
   };
-  for (int k = 0; k < 10; ++k) ASSERT_TRUE(state_then_nominal(60'000'000 + k * kPeriodUs));
+  for (int k = 0; k < 10; ++k) ASSERT_TRUE(state_then_nominal(60'000'000 + k * kSamplePeriodUs));
   EXPECT_EQ(counters.state(), health_state::kOk);
-  for (int k = 0; k < 40; ++k) EXPECT_FALSE(state_then_nominal(k * kPeriodUs));
+  for (int k = 0; k < 40; ++k) EXPECT_FALSE(state_then_nominal(k * kSamplePeriodUs));
   EXPECT_EQ(counters.state(), health_state::kFault);
   EXPECT_TRUE(counters.fault_latched());
   EXPECT_EQ(counters.counter("rejected_state_time_implausible"), 40);
-  EXPECT_EQ(counters.utime(), 60'000'000 + 9 * kPeriodUs);  // the newest time did not move
-  EXPECT_TRUE(state_then_nominal(60'000'000 + 10 * kPeriodUs));
+  EXPECT_EQ(counters.utime(), 60'000'000 + 9 * kSamplePeriodUs);  // the newest time did not move
+  EXPECT_TRUE(state_then_nominal(60'000'000 + 10 * kSamplePeriodUs));
   EXPECT_EQ(counters.state(), health_state::kOk);
   EXPECT_TRUE(counters.fault_latched());
 }

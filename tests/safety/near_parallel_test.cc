@@ -16,7 +16,7 @@ namespace {
 
 using Real = long double;
 
-struct Reference {
+struct ClpReference {
   bool feasible = false;
   Vector6d d = Vector6d::Zero();  // F* - F_des
 };
@@ -30,7 +30,7 @@ Real Dot(const Vector6d& a, const Vector6d& b) {
 // min ||d||^2 s.t. psi_i + g_i.d >= 0: the unique KKT point of a strictly
 // convex QP, found by trying every active set ({}, {p}, {v}, {p, v}) and
 // keeping the feasible one of least norm.
-Reference ExactQp(const TwoConstraintProblem& pr) {
+ClpReference ExactQp(const TwoConstraintProblem& pr) {
   const Real pp = Dot(pr.g_p, pr.g_p), vv = Dot(pr.g_v, pr.g_v), pv = Dot(pr.g_p, pr.g_v);
   // Lagrange's identity: the Gram determinant without cancellation.
   Real det = 0;
@@ -42,7 +42,7 @@ Reference ExactQp(const TwoConstraintProblem& pr) {
     }
   }
   const Real psi_p = pr.psi_p, psi_v = pr.psi_v;
-  Reference best;
+  ClpReference best;
   Real best_norm2 = INFINITY;
   auto consider = [&](Real mu_p, Real mu_v) {
     if (mu_p < 0 || mu_v < 0) return;
@@ -115,7 +115,7 @@ TEST(DegenerateNearParallel, BoundedAndTheQpOrTheFlaggedFallbackOverSin2From1e14
             std::fabs(pr.psi_p) / pr.g_p.norm() + std::fabs(pr.psi_v) / pr.g_v.norm();
         const TwoConstraintSolution s = SolveExactKkt(pr);
         const Vector6d d = s.mu_p * pr.g_p + s.mu_v * pr.g_v;
-        const Reference ref = ExactQp(pr);
+        const ClpReference ref = ExactQp(pr);
         ++checked;
         char where[200];
         std::snprintf(
