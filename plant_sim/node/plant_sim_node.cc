@@ -293,11 +293,7 @@ void PlantSimNode::UpdateTickCounters() {
 }
 
 void PlantSimNode::ApplyRealTimeDecision() {
-  // Judged on the tick's sample time only: counting the plant's own
-  // lateness too (a simulator behind its schedule) turned the actuators off
-  // on a congested link whenever the loop's CPU was busy (docs/operations.md,
-  // "Several hosts").
-  const RealTimeCommandHold::Decision d = hold_.Decide(tick_utime_, tick_utime_);
+  const RealTimeCommandHold::Decision d = hold_.Decide(tick_utime_);
   const bool off = d.actuators_off || guard_.tripped();
   plant_.SetActuatorsOff(off);
   if (!off) {

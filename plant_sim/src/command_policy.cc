@@ -22,10 +22,9 @@ void RealTimeCommandHold::OnCommand(const Vector6d& force_n, int64_t sample_utim
   last_force_n_ = force_n;
 }
 
-RealTimeCommandHold::Decision RealTimeCommandHold::Decide(int64_t tick_sample_utime,
-                                                          int64_t now_utime) const {
+RealTimeCommandHold::Decision RealTimeCommandHold::Decide(int64_t tick_sample_utime) const {
   Decision d;
-  const int64_t age_us = std::max(tick_sample_utime, now_utime) - sample_utime_;
+  const int64_t age_us = tick_sample_utime - sample_utime_;
   d.timed_out = !have_command_ || age_us > max_age_us_;
   if (d.timed_out || drive_off_) {
     // Nothing young enough to apply, or the supervisor's drive off: the

@@ -35,13 +35,12 @@ class RealTimeCommandHold {
     bool timed_out = false;  ///< no command young enough: actuators off
     int64_t age_us = -1;     ///< age of the command applied (-1: none applied)
   };
-  /// For the tick whose sample is `tick_sample_utime`, at `now_utime` on the
-  /// plant's clock in the same time base (real time: its start utime plus
-  /// the time run since). A command's age is counted to the later of the
-  /// two: a plant that fell behind its schedule (descheduled, stopped) and
-  /// catches up its ticks must not take a command for young because its
-  /// samples stood still meanwhile.
-  Decision Decide(int64_t tick_sample_utime, int64_t now_utime) const;
+  /// For the tick whose sample is `tick_sample_utime`: a command's age is
+  /// the tick's sample time minus the command's. The simulator's own
+  /// lateness (behind its schedule, catching up ticks) is not counted: a
+  /// late simulator is not a late platform, and counting it turned the
+  /// actuators off on a congested link (docs/operations.md, "Several hosts").
+  Decision Decide(int64_t tick_sample_utime) const;
 
  private:
   int64_t max_age_us_;
