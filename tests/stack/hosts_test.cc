@@ -3,7 +3,7 @@
 // host the estimator, controller and safety process, the observer the
 // recorder and the monitor, joined by LCM multicast with ttl=1 across the
 // bridge, started by tools/launch.sh --hosts. docs/operations.md, "Several
-// hosts".
+// hosts". The plant is not the model (--truth test::WriteMismatchedTruth).
 //
 // The lab here has names of its own (prefix stt, 10.78.0.0/24, groups
 // 239.255.78.0/24), so a developer's lab (stw) may be up beside it. Needs
@@ -126,7 +126,9 @@ TEST_F(HostsLab, NetworkCheckNamesAPartition) {
 TEST_F(HostsLab, PaperScenarioAcrossThreeHosts) {
   constexpr double kDurationS = 12.0;
   const test::LaunchResult run =
-      Launch("--duration " + std::to_string(kDurationS) + " --no-report", LabUrl(8013), "paper");
+      Launch("--duration " + std::to_string(kDurationS) + " --no-report --truth " +
+                 test::ShellQuote(test::WriteMismatchedTruth(run_folder_)),
+             LabUrl(8013), "paper");
   ASSERT_EQ(run.exit_code, 0) << test::LaunchFailure(run);
   const std::string folder = run_folder_ + "/paper";
   EXPECT_NE(test::ReadFile(folder + "/run.yaml").find("hosts: "), std::string::npos);
@@ -245,7 +247,8 @@ TEST_F(HostsLab, DelayLossAndAPartitionBetweenControlAndDevice) {
       15.0))
       << "the control host's heartbeats did not reach the device's group through the relay";
   auto plant = stack_process("device", device_url,
-                             {PLANT_SIM_PATH, "--mode", "realtime", "--duration", "40"});
+                             {PLANT_SIM_PATH, "--mode", "realtime", "--duration", "40", "--truth",
+                              test::WriteMismatchedTruth(run_folder_)});
 
   // Clean relay: armed, nominal commands.
   ASSERT_TRUE(pump_until(

@@ -7,6 +7,11 @@
 // estimator, controller, safety, stewart_logger), armed by the supervisor at
 // start-up as tools/launch.sh does in simulation. For every fault:
 //
+// The plant (plant_sim or the emulator) is not the model: --truth
+// test::WriteMismatchedTruth (heavier, a payload, joint errors, friction,
+// force-gain errors, a constant push), so the claims below hold against
+// physics the stack does not know exactly.
+//
 //   - no surviving process dies;
 //   - every limit holds on ground truth (STATE_TRUE, from plant_sim or the
 //     emulator), heard on the bus by the test;
@@ -148,6 +153,7 @@ class Stack {
                "\n  local_port: " + std::to_string(kDevicePort + 1) + "\n";
     }
     overlay_ = test::WriteAutoArmOverlay(folder_, extra);
+    truth_ = test::WriteMismatchedTruth(folder_);
     manual_arm_overlay_ = folder_ + "/manual_arm.yaml";
     std::ofstream(manual_arm_overlay_) << "supervisor:\n  auto_arm: false\n";
     config_ = LoadStackConfig(DefaultConfigPath(), {overlay_});
@@ -201,10 +207,11 @@ class Stack {
     return std::make_unique<test::ChildProcess>(argv);
   }
   std::unique_ptr<test::ChildProcess> StartPlantSim() const {
-    return std::make_unique<test::ChildProcess>(With({PLANT_SIM_PATH, "--mode", "realtime"}));
+    return std::make_unique<test::ChildProcess>(
+        With({PLANT_SIM_PATH, "--mode", "realtime", "--truth", truth_}));
   }
   std::unique_ptr<test::ChildProcess> StartEmulator() const {
-    return std::make_unique<test::ChildProcess>(With({HW_EMULATOR_PATH}));
+    return std::make_unique<test::ChildProcess>(With({HW_EMULATOR_PATH, "--truth", truth_}));
   }
   std::unique_ptr<test::ChildProcess> StartBridge() const {
     return std::make_unique<test::ChildProcess>(With({HW_BRIDGE_PATH}));
@@ -318,6 +325,7 @@ class Stack {
   std::string log_path_;
   std::string overlay_;
   std::string manual_arm_overlay_;
+  std::string truth_;  // the plant's physics: not the model (test::WriteMismatchedTruth)
   StackConfig config_;
   std::unique_ptr<lcm::LCM> lcm_;
 };

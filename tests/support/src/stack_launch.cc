@@ -29,6 +29,25 @@ std::string WriteAutoArmOverlay(const std::string& folder, const std::string& ex
   return path;
 }
 
+std::string WriteMismatchedTruth(const std::string& folder) {
+  const std::string path = folder + "/truth.yaml";
+  std::ofstream(path) << R"(# The plant differs from config/platform.yaml (the stack's model).
+platform:
+  mass_kg: 0.80
+  payload: {mass_kg: 0.15, position_m: [0.03, -0.02, 0.02]}
+  base_joint_radius_offsets_m: [0.0005, 0, -0.0005, 0, 0.0005, 0]
+  platform_joint_radius_offsets_m: [0, -0.0005, 0, 0.0005, 0, -0.0005]
+legs: {cylinder_mass_kg: 0.18, rod_mass_kg: 0.05}
+actuators:
+  viscous_friction_nspm: 3.0
+  coulomb_friction_n: 0.1
+  force_gain: [1.05, 0.95, 1.0, 1.0, 1.03, 0.97]
+disturbance:
+  constant_force_n: [0.3, -0.2, 0.2]
+)";
+  return path;
+}
+
 StackWithoutPlant::StackWithoutPlant(
     const StackPrograms& programs, const std::string& url, const std::string& log_path,
     const std::function<std::vector<std::string>(std::vector<std::string>)>& with)

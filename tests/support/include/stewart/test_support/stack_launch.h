@@ -88,6 +88,13 @@ bool PumpUntil(Receiver* receiver, Done done, double timeout_s) {
 /// returns its path.
 std::string WriteAutoArmOverlay(const std::string& folder, const std::string& extra_yaml = "");
 
+/// Writes `folder`/truth.yaml, the physics of a plant that is not the model
+/// (29 % heavier, a 0.15 kg payload off centre, heavier legs, joints 0.5 mm
+/// off, 1.5x friction plus Coulomb friction, force gains +-5 %, a constant
+/// push) yet inside what the stack holds its limits against: the plant the
+/// fault tests give plant_sim and hw_emulator (`--truth`); returns its path.
+std::string WriteMismatchedTruth(const std::string& folder);
+
 /// `argv` plus the flags every stack process of a test takes: the private
 /// `url`, the `overlay`, warnings only.
 std::vector<std::string> WithStackFlags(std::vector<std::string> argv, const std::string& url,
