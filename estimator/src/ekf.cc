@@ -518,6 +518,11 @@ UpdateResult Ekf::Update(const SensorSample& sample) {
   if (legs_ok) {
     follow_angles();
     CorrectLegs(sample.leg_length_m, trig, &events);
+  } else {
+    // The legs are the only absolute measurement of the pose: without them
+    // the estimate is a prediction, bridged for as many samples as a gated
+    // leg update, then given up (a sensor that only sends NaN).
+    ++consecutive_leg_rejections_;
   }
   if (sample.imu_valid) {
     if (sample.gyro_radps.allFinite() &&

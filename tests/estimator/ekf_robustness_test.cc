@@ -175,6 +175,31 @@ TEST(EkfRobustness, NoEstimateBeforeAValidLegReading) {
   EXPECT_TRUE(r.Has(kEventInitialized));
 }
 
+// A sensor that keeps sending samples without a usable leg reading (every
+// leg NaN): the prediction bridges divergence_rejections samples, then the
+// filter gives the estimate up until the legs read again.
+TEST(EkfRobustness, SamplesWithoutLegsAreBridgedThenTheEstimateIsGivenUp) {
+  const StackConfig& c = EstimatorTestConfig();
+  Ekf ekf = MakeEkf(c);
+  ScenarioTruth truth(c, 10);
+  for (int k = 0; k < 100; ++k) ASSERT_TRUE(ekf.Update(truth.Next().sensors).has_estimate);
+  int with_estimate = 0, diverged = 0;
+  for (int k = 0; k < 200; ++k) {
+    SensorSample s = truth.Next().sensors;
+    s.leg_length_m.setConstant(kNaN);
+    const UpdateResult r = ekf.Update(s);
+    EXPECT_TRUE(r.Has(kRejectLegsNonFinite));
+    with_estimate += r.has_estimate ? 1 : 0;
+    diverged += r.Has(kEventDiverged) ? 1 : 0;
+  }
+  EXPECT_EQ(with_estimate, c.estimator.divergence_rejections - 1);
+  EXPECT_EQ(diverged, 1);
+  EXPECT_FALSE(ekf.initialized());
+  const UpdateResult back = ekf.Update(truth.Next().sensors);
+  EXPECT_TRUE(back.has_estimate);
+  EXPECT_TRUE(back.Has(kEventInitialized));
+}
+
 TEST(EkfRobustness, BadSampleTimesAreRejectedOrRestart) {
   const StackConfig& c = EstimatorTestConfig();
   Ekf ekf = MakeEkf(c);
