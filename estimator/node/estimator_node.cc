@@ -17,7 +17,8 @@ EstimatorNode::EstimatorNode(const StackConfig& config, lcm::LCM* lcm, bool perf
       auth_(MessageAuthenticator::FromKeyFile(config.lcm.auth_key_file)),
       process_(config.platform, config.actuators, config.sensors, config.estimator,
                config.home_pose, &health_, config.lcm.time_plausibility,
-               AcceptorLimitsOf(config.guard, config.estimator.command_timeout_s)) {
+               AcceptorLimitsOf(config.guard, config.estimator.command_timeout_s),
+               config.guard.leg_force_limit_n) {
   if (perfect_state) {
     spdlog::warn("estimator: PERFECT STATE mode: republishing {} as {} (testing only)",
                  config_.lcm.channels.state_truth, config_.lcm.channels.state_estimate);

@@ -26,13 +26,15 @@ EstimatorProcess::EstimatorProcess(const PlatformParams& platform, const Actuato
                                    const SensorConfig& sensors, const EstimatorConfig& estimator,
                                    const Vector6d& home_pose, HealthCounters* counters,
                                    const TimePlausibilityParams& time,
-                                   std::optional<SafeCommandAcceptorLimits> trust)
+                                   std::optional<SafeCommandAcceptorLimits> trust,
+                                   double guard_force_limit_n)
     : ekf_(platform, actuators, sensors, estimator, home_pose),
       counters_(counters),
-      time_check_(time, estimator.perfect_state ? "truth" : "sensor", estimator.max_dt_s,
-                  counters) {
+      time_check_(time, estimator.perfect_state ? "truth" : "sensor", estimator.max_dt_s, counters),
+      guard_force_limit_n_(guard_force_limit_n) {
   if (trust) acceptor_.emplace(*trust);
   STEWART_CHECK(counters_ != nullptr, "EstimatorProcess needs its counters");
+  STEWART_CHECK(guard_force_limit_n_ > 0.0, "guard_force_limit_n must be positive");
 }
 
 AnnouncementVerdict EstimatorProcess::OnAnnouncement(const SessionAnnouncement& announcement,
@@ -62,6 +64,11 @@ bool EstimatorProcess::OnCommand(const ForceCommand& command, StateSample* out,
                  acceptor_ ? acceptor_->Check(command, authentic) : CommandRejection::kNone;
              rejection != CommandRejection::kNone) {
     counters_->Reject(ToString(rejection));
+  } else if ((command.flags & kCommandDriveOff) == 0 &&
+             command.force_n.cwiseAbs().maxCoeff() > guard_force_limit_n_) {
+    // The actuators' guard trips on it and turns the drive off.
+    counters_->Reject("command_beyond_guard_force");
+    ekf_.SetForceCommand(command.sample_utime, Vector6d::Zero(), /*drive_off=*/true);
   } else {
     ekf_.SetForceCommand(command.sample_utime, command.force_n,
                          (command.flags & kCommandDriveOff) != 0);

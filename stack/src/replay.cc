@@ -610,7 +610,8 @@ EstimatorReplayResult ReplayEstimator(const StackConfig& config, const RecordedL
   // (the announced session, its MAC): replay decides the same from the log.
   EstimatorProcess process(config.platform, config.actuators, config.sensors, config.estimator,
                            config.home_pose, &counters, config.lcm.time_plausibility,
-                           AcceptorLimitsOf(config.guard, config.estimator.command_timeout_s));
+                           AcceptorLimitsOf(config.guard, config.estimator.command_timeout_s),
+                           config.guard.leg_force_limit_n);
   MessageAuthenticator auth = RecordedRunAuthenticator(config);
   auto compare = [&](const StateSample& sample) {
     state_t replayed{};

@@ -11,7 +11,10 @@
 //   0.524 m, limit 0.51): without a key from no session and as the real
 //   command's copy (its session and seq), with a key as the real session's
 //   next seq without a valid MAC. plant_sim drops every one; the platform
-//   keeps its limits on ground truth.
+//   keeps its limits on ground truth. Without a key, a copy of a real
+//   command that plant_sim lost is indistinguishable from it: then its guard
+//   trips on the copy's force (the only trip accepted), and the estimator,
+//   which may lose one too, takes such a force as the drive off.
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/stat.h>
@@ -122,8 +125,10 @@ struct Stack {
       out << "lcm:\n  auth_key_file: \"" << key << "\"\n";
     }
     out.close();
+    // Errors only: a failure's own lines must stay near the top of the
+    // test's output (a loaded machine logs every late tick as a warning).
     const std::vector<std::string> common = {"--lcm-url", url,           "--overlay",
-                                             overlay,     "--log-level", "warn"};
+                                             overlay,     "--log-level", "error"};
     auto with = [&](std::vector<std::string> head) {
       head.insert(head.end(), common.begin(), common.end());
       return head;
@@ -230,13 +235,29 @@ TEST_P(ActuatorTrustAttack, ForgedCommandsAreDroppedAndTheLimitsHold) {
   // leg 0 at -21.3 N, and plant_sim's guard had to hold the platform).
   ASSERT_FALSE(bus.estimator.empty());
   EXPECT_GE(Counter(bus.estimator.back(), c.counter), bus.forged - 50) << c.counter;
-  EXPECT_EQ(Counter(bus.plant, "guard_trips"), 0);
+  const int64_t trips = Counter(bus.plant, "guard_trips");
+  if (c.forgery == Forgery::kCopyOfTheReal && trips == 1) {
+    // Without a key a copy is the real command to whoever lost the real one
+    // (a full socket buffer on a loaded machine): plant_sim then trusts it,
+    // and its guard must turn the drive off on the 1e300 N it carries.
+    EXPECT_NE(bus.plant.last_error.find("commanded force 1e+300 N beyond the bound"),
+              std::string::npos)
+        << bus.plant.last_error;
+    std::printf("[trust] plant_sim lost a real command and trusted its copy: %s\n",
+                bus.plant.last_error.c_str());
+  } else {
+    EXPECT_EQ(trips, 0) << bus.plant.last_error;
+  }
   std::printf("[trust] plant_sim: %s; estimator: %s\n", bus.plant.last_error.c_str(),
               bus.estimator.empty() ? "-" : bus.estimator.back().last_error.c_str());
-  std::printf("[trust] %s%s: %ld forgeries, %lld dropped as %s, guard trips %lld\n",
-              c.with_key ? "key, " : "no key, ", c.counter, bus.forged,
-              static_cast<long long>(Counter(bus.plant, c.counter)), c.counter,
-              static_cast<long long>(Counter(bus.plant, "guard_trips")));
+  std::printf(
+      "[trust] %s%s: %ld forgeries, %lld dropped as %s, guard trips %lld; the estimator took "
+      "%lld as drive off (beyond the guard's force bound)\n",
+      c.with_key ? "key, " : "no key, ", c.counter, bus.forged,
+      static_cast<long long>(Counter(bus.plant, c.counter)), c.counter,
+      static_cast<long long>(Counter(bus.plant, "guard_trips")),
+      static_cast<long long>(std::max<int64_t>(
+          0, Counter(bus.estimator.back(), "rejected_command_beyond_guard_force"))));
   ExpectZLimitsHeld(bus, config);
 }
 

@@ -5,6 +5,7 @@
 // (ground truth republished, testing only). The node (estimator/node)
 // converts messages and publishes; replay drives the same class.
 #include <cstdint>
+#include <limits>
 #include <optional>
 
 #include "stewart/common/health_counters.h"
@@ -31,11 +32,18 @@ class EstimatorProcess {
   /// rising seq, a fresh sample), so a forgery the plant drops cannot move
   /// the estimate either. Absent: every finite command with a plausible time
   /// (the in-process loop, which hands over the safety process's own output).
+  /// `guard_force_limit_n`: the actuators' guard.leg_force_limit_n (N). A
+  /// command beyond it in magnitude on any leg trips their guard, which turns
+  /// the drive off instead of applying it: the process model takes such a
+  /// command as drive off and counts it (`command_beyond_guard_force`), so a
+  /// command the actuators never apply (a replayed forgery that replaced a
+  /// real command lost on the way, without a key) cannot wreck the estimate.
   EstimatorProcess(const PlatformParams& platform, const ActuatorConfig& actuators,
                    const SensorConfig& sensors, const EstimatorConfig& estimator,
                    const Vector6d& home_pose, HealthCounters* counters,
                    const TimePlausibilityParams& time = {},
-                   std::optional<SafeCommandAcceptorLimits> trust = std::nullopt);
+                   std::optional<SafeCommandAcceptorLimits> trust = std::nullopt,
+                   double guard_force_limit_n = std::numeric_limits<double>::infinity());
 
   /// A safety session announcement (supervisor_state_t); `authentic`: its
   /// MAC verified (true without a key); `wall_us`: the receiver's monotonic
@@ -101,6 +109,7 @@ class EstimatorProcess {
   HealthCounters* counters_;
   InputTimeCheck time_check_;
   std::optional<SafeCommandAcceptor> acceptor_;
+  double guard_force_limit_n_;
   ResendAnswer resend_;
   StateSample last_answer_;  ///< the estimate answering the sample resend_ holds
   int64_t seq_ = 0;
