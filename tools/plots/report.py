@@ -205,7 +205,14 @@ def supervisor_rows(run, config):
         return list(csv.DictReader(f))
 
 
-def supervisor_section(run, config):
+def supervisor_t_s(row, t0):
+    """A supervisor row's stack time from the first state (s); one made before the supervisor
+    saw any state (utime 0: power-on) counts as the start."""
+    utime = int(row["utime_us"])
+    return (utime - t0) * 1e-6 if utime > 0 else 0.0
+
+
+def supervisor_section(run, config, t0):
     """The supervisor's states through the run (docs/operations.md, "Arming and e-stop"):
     each change with its stack time and reason, from the recorded supervisor_state_t; the
     HOLDs and ESTOPs counted with their reasons."""
@@ -213,8 +220,9 @@ def supervisor_section(run, config):
     if not rows:
         return []
     lines = ["## Supervisor", "",
-             "State changes of the supervisor (stack time of the decision; docs/operations.md, "
-             "\"Arming and e-stop\"). The motion clock is the stack time spent ARMING or ARMED.",
+             "State changes of the supervisor (stack time of the decision from the first "
+             "state, as every t of this report; docs/operations.md, \"Arming and e-stop\"). "
+             "The motion clock is the stack time spent ARMING or ARMED.",
              "", "| t (s) | state | reason |", "| --- | --- | --- |"]
     previous = None
     stops = []
@@ -223,7 +231,7 @@ def supervisor_section(run, config):
         if key == previous:
             continue
         previous = key
-        t = int(row["utime_us"]) * 1e-6
+        t = supervisor_t_s(row, t0)
         state = SUPERVISOR_STATES.get(int(row["state"]), row["state"])
         lines.append(f"| {t:.3f} | {state} | {row['reason']} |")
         if state in ("HOLD", "ESTOP"):
@@ -567,7 +575,7 @@ def main():
     lines += ["## Warnings", ""] + ([f"- {w}" for w in warnings] if warnings else ["None."])
     lines += [""] + recording_lines
     lines += limits_section(state, on_truth, safety, t)
-    lines += supervisor_section(run, config)
+    lines += supervisor_section(run, config, t0)
     lines += health_section(run, config, t_of, continuity)
 
     if diag is not None:
@@ -665,7 +673,7 @@ def main():
         axes[3, 2].set_ylabel("filter time (us)")
     supervisor = supervisor_rows(run, config)
     if supervisor:
-        ts = [(int(r["utime_us"]) - t0) * 1e-6 for r in supervisor]
+        ts = [supervisor_t_s(r, t0) for r in supervisor]
         axes[4, 0].step(ts, [int(r["state"]) for r in supervisor], where="post", lw=0.8)
     axes[4, 0].set_yticks(list(SUPERVISOR_STATES))
     axes[4, 0].set_yticklabels(list(SUPERVISOR_STATES.values()), fontsize=7)
