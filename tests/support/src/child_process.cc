@@ -17,8 +17,10 @@ ChildProcess::ChildProcess(std::vector<std::string> argv) {
   pid_ = fork();
   if (pid_ == 0) {
     // Dies with the test, even when the test is killed: no stray process
-    // keeps a port or a multicast group busy.
-    prctl(PR_SET_PDEATHSIG, SIGTERM);
+    // keeps a port or a multicast group busy. SIGKILL, not SIGTERM: a child
+    // the test had stopped (SIGSTOP, the fault suite) would keep a SIGTERM
+    // pending forever.
+    prctl(PR_SET_PDEATHSIG, SIGKILL);
     execv(args[0], args.data());
     _exit(127);
   }

@@ -15,7 +15,8 @@
 namespace stewart::test {
 
 LauncherLock::LauncherLock()
-    : fd_(open(STEWART_BUILD_DIR "/stack_launch.lock", O_CREAT | O_RDWR, 0644)) {
+    // Close-on-exec: a child that outlived its test must not hold the lock.
+    : fd_(open(STEWART_BUILD_DIR "/stack_launch.lock", O_CREAT | O_RDWR | O_CLOEXEC, 0644)) {
   if (fd_ >= 0) flock(fd_, LOCK_EX);
 }
 
