@@ -175,6 +175,8 @@ void Ekf::Reset() {
   qdd_.setZero();
   consecutive_leg_rejections_ = 0;
   consecutive_accel_gated_ = 0;
+  pose_reopened_utime_.reset();
+  samples_since_accel_disagreed_ = kNeverDisagreed;
   samples_since_init_ = 0;
 }
 
@@ -192,6 +194,8 @@ void Ekf::Initialize(int64_t utime, const Vector6d& q, const Vector6d& qd, const
   initialized_ = true;
   consecutive_leg_rejections_ = 0;
   consecutive_accel_gated_ = 0;
+  pose_reopened_utime_.reset();
+  samples_since_accel_disagreed_ = kNeverDisagreed;
   samples_since_init_ = 0;
 }
 
@@ -384,12 +388,57 @@ void Ekf::CorrectLegs(const Vector6d& leg_length_m, const EulerAngleTrig& trig, 
   Matrix6d J;
   PredictLegLengths(params_, Vector6d(x_.segment<6>(kEkfQ)), trig, &predicted, &J);
   const Matrix6d R = Matrix6d::Identity() * leg_variance_m2_;
-  if (Correct<6, 2>(leg_length_m - predicted, {kEkfQ, kEkfQ + 3}, J, R, &last_leg_nis_)) {
+  const Vector6d y = leg_length_m - predicted;
+  if (Correct<6, 2>(y, {kEkfQ, kEkfQ + 3}, J, R, &last_leg_nis_)) {
     consecutive_leg_rejections_ = 0;
-  } else {
-    *events |= kGateLegs;
-    ++consecutive_leg_rejections_;
+    return;
   }
+  ++consecutive_leg_rejections_;
+  if (ReopenPoseAfterUnmodelledForce() &&
+      Correct<6, 2>(y, {kEkfQ, kEkfQ + 3}, J, R, &last_leg_nis_)) {
+    *events |= kEventPoseReopened;
+    consecutive_leg_rejections_ = 0;
+    return;
+  }
+  *events |= kGateLegs;
+}
+
+bool Ekf::ReopenPoseAfterUnmodelledForce() {
+  // The legs disagree for a few samples in a row while the accelerometer
+  // disagrees too, or did so lately: not a bad leg reading but a force the
+  // model lacks (a heavier platform armed, a push), which moved the platform
+  // away from the prediction before d could follow: by up to M^-1 d T^2/2 in
+  // pose and M^-1 d T in velocity, d of a jump's size acting since the
+  // accelerometer's disagreement began. Widening the pose and velocity
+  // uncertainty by that much lets the legs back in. Without it they stayed
+  // gated until the estimate restarted (through hw_bridge, a platform 0.33 kg
+  // heavier than the model restarted it twice while arming, and the
+  // supervisor held instead of arming). At most once per
+  // kMinReopenIntervalS: against a plant whose joints are not the model's
+  // the legs disagree every few samples, and re-opening each time would grow
+  // the pose uncertainty without bound; legs that still disagree end in a
+  // restart as before.
+  const bool reopened_lately =
+      pose_reopened_utime_ &&
+      static_cast<double>(last_utime_ - *pose_reopened_utime_) * kUsToS < kMinReopenIntervalS;
+  if (!config_.estimate_disturbance || reopened_lately ||
+      consecutive_leg_rejections_ < kReopenAfterGatedLegs ||
+      samples_since_accel_disagreed_ > config_.divergence_rejections) {
+    return false;
+  }
+  pose_reopened_utime_ = last_utime_;
+  const double window_s =
+      std::clamp(static_cast<double>(last_utime_ - accel_disagreement_start_utime_) * kUsToS, 0.0,
+                 kMaxReopenWindowS);
+  Vector6d jump_std;
+  jump_std << Vector3d::Constant(config_.disturbance_jump_std_n),
+      Vector3d::Constant(config_.disturbance_jump_std_nm);
+  Eigen::Matrix<double, 12, 6> drift;  // d(q, qd) / d(force), over the window
+  drift.topRows<6>() = (0.5 * window_s * window_s) * m_inv_;
+  drift.bottomRows<6>() = window_s * m_inv_;
+  drift *= jump_std.asDiagonal();
+  P_.topLeftCorner<12, 12>().noalias() += drift * drift.transpose();
+  return true;
 }
 
 void Ekf::CorrectGyro(const Vector3d& gyro_radps, const EulerAngleTrig& trig, uint32_t* events) {
@@ -444,8 +493,14 @@ void Ekf::CorrectAccel(const Vector3d& accel_mps2, const EulerAngleTrig& trig, u
   const std::array<int, 4> blocks = {kEkfQ + 3, kEkfQd + 3, kEkfDisturbance, kEkfDisturbance + 3};
   if (Correct<3, 4>(y, blocks, h, R, &nis)) {
     consecutive_accel_gated_ = 0;
+    samples_since_accel_disagreed_ = std::min(samples_since_accel_disagreed_ + 1, kNeverDisagreed);
     return;
   }
+  // A disagreement starts: when the unmodelled force began to act.
+  if (samples_since_accel_disagreed_ > config_.disturbance_jump_after_samples) {
+    accel_disagreement_start_utime_ = last_utime_;
+  }
+  samples_since_accel_disagreed_ = 0;
   // Beyond the gate for long enough to be a step in d (a push, a payload set
   // down) that the random walk cannot follow, not the transient of a command
   // the actuators apply later than the model assumes: re-open d's

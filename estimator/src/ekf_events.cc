@@ -38,6 +38,8 @@ const char* EkfEventName(EkfEvent event) {
       return "disturbance_jumps";
     case kEventLegsHeld:
       return "predict_legs_held";
+    case kEventPoseReopened:
+      return "pose_reopened";
   }
   return "unknown";
 }

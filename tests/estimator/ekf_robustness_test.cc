@@ -299,7 +299,8 @@ TEST(EkfEvents, EveryEventHasADistinctName) {
   for (uint32_t bit = 1; bit <= kEventLast; bit <<= 1) {
     names.insert(EkfEventName(static_cast<EkfEvent>(bit)));
   }
-  EXPECT_EQ(names.size(), 17u);
+  EXPECT_EQ(names.size(), 18u);
+  EXPECT_FALSE(IsRejection(kEventPoseReopened));
   EXPECT_FALSE(IsRejection(kEventLegsHeld));
   EXPECT_FALSE(IsRejection(kEventDisturbanceJump));
   EXPECT_EQ(names.count("unknown"), 0u);

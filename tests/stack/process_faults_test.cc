@@ -7,10 +7,10 @@
 // estimator, controller, safety, stewart_logger), armed by the supervisor at
 // start-up as tools/launch.sh does in simulation. For every fault:
 //
-// plant_sim is not the model: --truth test::WriteMismatchedTruth (heavier,
-// a payload, joint errors, friction, force-gain errors, a constant push), so
-// the claims below hold against physics the stack does not know exactly.
-// hw_emulator still runs the model's physics (see StartEmulator).
+// plant_sim and hw_emulator are not the model: --truth
+// test::WriteMismatchedTruth (heavier, a payload, joint errors, friction,
+// force-gain errors, a constant push), so the claims below hold against
+// physics the stack does not know exactly.
 //
 //   - no surviving process dies;
 //   - every limit holds on ground truth (STATE_TRUE, from plant_sim or the
@@ -211,9 +211,7 @@ class Stack {
         With({PLANT_SIM_PATH, "--mode", "realtime", "--truth", truth_}));
   }
   std::unique_ptr<test::ChildProcess> StartEmulator() const {
-    // The model's physics: with truth_, the hardware path once failed to arm
-    // (the estimator restarted in the arming ramp; docs/operations.md).
-    return std::make_unique<test::ChildProcess>(With({HW_EMULATOR_PATH}));
+    return std::make_unique<test::ChildProcess>(With({HW_EMULATOR_PATH, "--truth", truth_}));
   }
   std::unique_ptr<test::ChildProcess> StartBridge() const {
     return std::make_unique<test::ChildProcess>(With({HW_BRIDGE_PATH}));

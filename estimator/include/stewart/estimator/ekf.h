@@ -4,6 +4,7 @@
 // model, the tuning and the measured accuracy. No LCM, no heap allocation
 // per update, and time only from the samples' utime.
 #include <array>
+#include <optional>
 
 #include "stewart/estimator/ekf_types.h"
 #include "stewart/estimator/estimator_config.h"
@@ -106,6 +107,19 @@ class Ekf {
   const TimedCommand* ActingCommand(int64_t interval_start_utime) const;
   int consecutive_leg_rejections_ = 0;
   int consecutive_accel_gated_ = 0;
+  /// See ReopenPoseAfterUnmodelledForce: the legs gated this many samples
+  /// in a row first (a single bad reading is only gated), and the longest
+  /// window the drift is sized for (s).
+  static constexpr int kReopenAfterGatedLegs = 3;
+  static constexpr double kMaxReopenWindowS = 0.05;
+  static constexpr int kNeverDisagreed = 1 << 30;
+  /// Widens the pose and velocity uncertainty by the drift of an unmodelled
+  /// force, when the legs and the accelerometer both disagree; true if done.
+  bool ReopenPoseAfterUnmodelledForce();
+  static constexpr double kMinReopenIntervalS = 0.5;
+  std::optional<int64_t> pose_reopened_utime_;           ///< the latest re-opening
+  int samples_since_accel_disagreed_ = kNeverDisagreed;  ///< gated or jumped
+  int64_t accel_disagreement_start_utime_ = 0;  ///< first sample of the latest disagreement
   int samples_since_init_ = 0;
   bool diverged_ = false;
   double last_leg_nis_ = 0.0;

@@ -78,7 +78,10 @@ enum EkfEvent : uint32_t {
   /// DC-motor legs without drive (no fresh command, or an all-zero one):
   /// predicted as held by their self-locking screws, not by the dynamics.
   kEventLegsHeld = 1u << 16,
-  kEventLast = kEventLegsHeld,
+  /// At a disturbance jump with the legs gated: the pose and velocity
+  /// uncertainty widened by the drift the step caused before it was seen.
+  kEventPoseReopened = 1u << 17,
+  kEventLast = kEventPoseReopened,
 };
 
 /// Short snake_case name of one event bit (health counter names).
