@@ -7,6 +7,7 @@
 #include <tuple>
 
 #include "stewart/common/check.h"
+#include "stewart/guard/actuator_guard.h"
 
 namespace stewart {
 
@@ -65,7 +66,7 @@ bool EstimatorProcess::OnCommand(const ForceCommand& command, StateSample* out,
              rejection != CommandRejection::kNone) {
     counters_->Reject(ToString(rejection));
   } else if ((command.flags & kCommandDriveOff) == 0 &&
-             command.force_n.cwiseAbs().maxCoeff() > guard_force_limit_n_) {
+             AnyForceBeyondGuardBound(command.force_n, guard_force_limit_n_)) {
     // The actuators' guard trips on it and turns the drive off.
     counters_->Reject("command_beyond_guard_force");
     ekf_.SetForceCommand(command.sample_utime, Vector6d::Zero(), /*drive_off=*/true);

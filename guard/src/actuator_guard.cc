@@ -57,8 +57,7 @@ bool ActuatorGuard::OnForceCommand(const Vector6d& force_n) {
   bool tripped_now = false;
   for (int i = 0; i < kNumLegs; ++i) {
     const double f = force_n(i);
-    // !(|f| <= bound) also catches NaN.
-    if (!(std::abs(f) <= limits_.force_limit_n)) {
+    if (ForceBeyondGuardBound(f, limits_.force_limit_n)) {
       tripped_now |= Trip(GuardTripReason::kForce, i, f);
     } else {
       max_force_n_ = std::max(max_force_n_, std::abs(f));

@@ -78,8 +78,9 @@ enum EkfEvent : uint32_t {
   /// DC-motor legs without drive (no fresh command, or an all-zero one):
   /// predicted as held by their self-locking screws, not by the dynamics.
   kEventLegsHeld = 1u << 16,
-  /// At a disturbance jump with the legs gated: the pose and velocity
-  /// uncertainty widened by the drift the step caused before it was seen.
+  /// Legs gated 3 samples in a row while the accelerometer disagreed too:
+  /// the pose and velocity uncertainty widened by the drift of an unmodelled
+  /// force, and the legs used (Ekf::ReopenPoseAfterUnmodelledForce).
   kEventPoseReopened = 1u << 17,
   kEventLast = kEventPoseReopened,
 };

@@ -12,6 +12,7 @@
 // within the cap (Reset). The first trip's reason is kept for the report.
 // No allocation; Describe() builds the health message, on a trip only.
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <string>
 
@@ -66,6 +67,19 @@ inline constexpr EnumTable<GuardResetResult, 3> kGuardResetResultNames{{{
     {GuardResetResult::kReadingsOutside, "readings_outside"},
 }}};
 inline const char* ToString(GuardResetResult r) { return kGuardResetResultNames.Name(r).data(); }
+
+/// The guard's force rule: a leg force command (N) beyond `force_limit_n` in
+/// magnitude, or NaN, trips it (the drive goes off instead of applying it).
+inline bool ForceBeyondGuardBound(double force_n, double force_limit_n) {
+  return !(std::abs(force_n) <= force_limit_n);
+}
+/// The same rule over all legs (the estimator models the guard with it).
+inline bool AnyForceBeyondGuardBound(const Vector6d& force_n, double force_limit_n) {
+  for (int i = 0; i < force_n.size(); ++i) {
+    if (ForceBeyondGuardBound(force_n(i), force_limit_n)) return true;
+  }
+  return false;
+}
 
 class ActuatorGuard {
  public:
