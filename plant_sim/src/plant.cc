@@ -48,6 +48,7 @@ void Plant::Reset(double t_s, const Vector6d& q, const Vector6d& qd) {
   endstop_hits_ = 0;
   self_lock_engagements_ = 0;
   delayed_head_ = delayed_count_ = 0;
+  release_pending_ = false;
   MarkDiscontinuity();
 }
 
@@ -72,14 +73,27 @@ void Plant::QueueCommand(const Vector6d& command) {
     return;
   }
   if (delayed_count_ == kDelayCapacity) {
-    ApplyCommand(delayed_[static_cast<size_t>(delayed_head_)].command);
+    ApplyDelayed(delayed_[static_cast<size_t>(delayed_head_)]);
     delayed_head_ = (delayed_head_ + 1) % kDelayCapacity;
     --delayed_count_;
     ++delayed_dropped_;
   }
   const int tail = (delayed_head_ + delayed_count_) % kDelayCapacity;
-  delayed_[static_cast<size_t>(tail)] = DelayedCommand{t_s_ + model_.command_delay_s, command};
+  delayed_[static_cast<size_t>(tail)] =
+      DelayedCommand{t_s_ + model_.command_delay_s, command, release_pending_};
+  release_pending_ = false;
   ++delayed_count_;
+}
+
+void Plant::ApplyDelayed(const DelayedCommand& delayed) {
+  if (delayed.releases) ReleaseLegs();
+  ApplyCommand(delayed.command);
+}
+
+void Plant::ReleaseLegs() {
+  if (!inputs_.legs_locked) return;
+  inputs_.legs_locked = false;
+  MarkDiscontinuity();
 }
 
 void Plant::SetExternalWrench(const Vector6d& wrench) {
@@ -135,13 +149,20 @@ void Plant::UpdateSelfLocking() {
 }
 
 void Plant::SetActuatorsOff(bool off) {
-  if (off == inputs_.legs_locked) return;
-  inputs_.legs_locked = off;
-  if (off) {
-    inputs_.lock_length_m = InverseKinematics(model_.platform, q());
-    delayed_head_ = delayed_count_ = 0;
-    ApplyCommand(Vector6d::Zero());
+  if (!off) {
+    if (model_.command_delay_s > 0.0) {
+      release_pending_ = inputs_.legs_locked;
+    } else {
+      ReleaseLegs();
+    }
+    return;
   }
+  release_pending_ = false;
+  if (inputs_.legs_locked) return;
+  inputs_.legs_locked = true;
+  inputs_.lock_length_m = InverseKinematics(model_.platform, q());
+  delayed_head_ = delayed_count_ = 0;
+  ApplyCommand(Vector6d::Zero());
   MarkDiscontinuity();
 }
 
@@ -151,7 +172,7 @@ void Plant::Advance(double dt_s) {
   while (delayed_count_ > 0 && delayed_[static_cast<size_t>(delayed_head_)].apply_s < t_end) {
     const DelayedCommand& next = delayed_[static_cast<size_t>(delayed_head_)];
     if (next.apply_s > t_s_) IntegrateTo(next.apply_s);
-    ApplyCommand(next.command);
+    ApplyDelayed(next);
     delayed_head_ = (delayed_head_ + 1) % kDelayCapacity;
     --delayed_count_;
   }

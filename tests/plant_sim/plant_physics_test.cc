@@ -87,6 +87,45 @@ TEST(PlantLock, ActuatorsOffHoldLegLengths) {
   EXPECT_LT(falling.q()(2), Config().plant_sim.initial_pose(2) - 0.02);
 }
 
+// Under a command delay the drive returns with its command: the legs stay
+// held until the first force after SetActuatorsOff(false) takes effect.
+// Released at once, the legs were free and unpowered for the delay (a 1.5 ms
+// free fall that the estimator's accelerometer read as an 8 N model error,
+// and restarted on, each time the drive came back).
+TEST(PlantLock, TheDriveReturnsWithItsDelayedCommand) {
+  PlantModel model = test::DefaultModel();
+  model.command_delay_s = 2e-3;
+  Plant plant(model, test::OdeOptionsFor("arkode_erk"));
+  const Vector6d pose = Config().plant_sim.initial_pose;
+  plant.Reset(0.0, pose, Vector6d::Zero());
+  plant.SetActuatorsOff(true);
+  for (int k = 0; k < 100; ++k) plant.Advance(1e-3);
+  // The force that holds the platform where it is (no friction at rest).
+  const Vector6d hover_n = test::HoldingForce(model.platform, pose);
+  plant.SetActuatorsOff(false);
+  plant.SetForceCommand(hover_n);
+  for (int k = 0; k < 2; ++k) {
+    plant.Advance(0.9e-3);
+    EXPECT_TRUE(plant.actuators_off()) << "released before its command, at " << plant.time_s();
+  }
+  EXPECT_LT(plant.qd().norm(), 1e-3);
+  plant.Advance(1e-3);  // the command is in effect
+  EXPECT_FALSE(plant.actuators_off());
+  EXPECT_EQ(plant.inputs().force_cmd_n, hover_n);
+  for (int k = 0; k < 20; ++k) plant.Advance(1e-3);
+  // Held, then hovering: the platform never fell.
+  EXPECT_LT(std::abs(plant.qd()(2)), 1e-3);
+  EXPECT_NEAR(plant.q()(2), pose(2), 1e-4);
+
+  // Off again: held at once, and a release without a command keeps it held.
+  plant.SetActuatorsOff(true);
+  EXPECT_TRUE(plant.actuators_off());
+  plant.SetActuatorsOff(false);
+  for (int k = 0; k < 5; ++k) plant.Advance(1e-3);
+  EXPECT_TRUE(plant.actuators_off());
+  EXPECT_LT(plant.qd().norm(), 1e-3);
+}
+
 TEST(ActuatorModel, SaturationFrictionEndStopClamp) {
   ActuatorConfig a = Config().actuators;
   Vector6d f;

@@ -41,6 +41,10 @@ class Plant {
   /// length at this instant (LegLockForce; a DC motor's legs self-lock one by
   /// one as they stop); drops commands not yet in effect. Restarts the
   /// integrator on change.
+  /// Actuators on again: the drive returns with the next command, so under a
+  /// command delay the legs stay held until that command takes effect (the
+  /// real drive gets both through the same link; releasing at once left the
+  /// legs unpowered and free for the delay, a platform's free fall).
   void SetActuatorsOff(bool off);
   /// External wrench from now on ([N; N m] in {B}, PlantInputs).
   void SetExternalWrench(const Vector6d& wrench);
@@ -74,12 +78,15 @@ class Plant {
  private:
   struct DelayedCommand {
     double apply_s;
-    Vector6d command;  // force (N) or, for a DC motor, duty
+    Vector6d command;       // force (N) or, for a DC motor, duty
+    bool releases = false;  // the drive returns with it (SetActuatorsOff(false))
   };
   // Room for 0.5 s of delay at 1 kHz: far beyond any latency worth simulating.
   static constexpr int kDelayCapacity = 512;
 
   void QueueCommand(const Vector6d& command);
+  void ApplyDelayed(const DelayedCommand& delayed);
+  void ReleaseLegs();
   // Force (ideal source) or duty (DC motor) from now on.
   void ApplyCommand(const Vector6d& command);
   // DC motor: which legs the self-locking screws hold, judged at the state
@@ -127,7 +134,8 @@ class Plant {
   int delayed_head_ = 0;
   int delayed_count_ = 0;
   long delayed_dropped_ = 0;
-  PlantRates rates_;  // f at rates_x_ under rates_revision_; no allocation per call
+  bool release_pending_ = false;  // SetActuatorsOff(false) waits for the next command
+  PlantRates rates_;              // f at rates_x_ under rates_revision_; no allocation per call
   PlantStateVector rates_x_ = PlantStateVector::Zero();
   long rates_revision_ = -1;  // -1: rates_ holds nothing yet
 };
