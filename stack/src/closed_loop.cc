@@ -150,6 +150,9 @@ ClosedLoopSummary RunClosedLoop(const StackConfig& config, const Scenario& scena
       sample.accel_mps2 = r.accel_mps2;
       sample.has_orientation = r.has_orientation;
       sample.orientation_rpy_rad = r.orientation_rpy_rad;
+      // As plant_sim's STATUS_ACTUATORS_OFF: the legs are held (the drive
+      // off, or its return not yet in effect under a command delay).
+      sample.drive_off = plant.actuators_off();
       has_state = estimator.OnSensor(sample, &state);
       if (has_state) {
         sq_q += (state.q - q_true).head<3>().squaredNorm();
