@@ -17,12 +17,16 @@ bool Moving(SupervisorState s) {
 Supervisor::Supervisor(const SupervisorConfig& config) : config_(config) {
   STEWART_CHECK(config_.arming_ramp_s >= 0.0, "supervisor.arming_ramp_s must be >= 0");
   STEWART_CHECK(config_.fallback_latch_s >= 0.0, "supervisor.fallback_latch_s must be >= 0");
+  STEWART_CHECK(config_.hold_brake_s >= 0.0, "supervisor.hold_brake_s must be >= 0");
 }
 
 double Supervisor::blend() const { return blend_; }
 
 void Supervisor::Enter(SupervisorState next, const std::string& reason) {
-  if (next != state_) ++transitions_;
+  if (next != state_) {
+    ++transitions_;
+    hold_since_utime_ = -1;  // a HOLD's brake starts at its first step
+  }
   state_ = next;
   reason_ = reason;
   if (next == SupervisorState::kArming) {
@@ -74,7 +78,13 @@ SupervisorMode Supervisor::OnStep(const SupervisorStep& step) {
         config_.arming_ramp_s > 0.0 ? std::clamp(elapsed_s / config_.arming_ramp_s, 0.0, 1.0) : 1.0;
     if (blend_ >= 1.0) Enter(SupervisorState::kArmed, reason_);
   }
-  return SupervisorMode{state_, blend_};
+  SupervisorMode mode{state_, blend_};
+  if (state_ == SupervisorState::kHold) {
+    if (hold_since_utime_ < 0) hold_since_utime_ = step.utime;
+    mode.hold_locked = config_.hold_drive_off &&
+                       step.utime - hold_since_utime_ >= std::llround(config_.hold_brake_s * 1e6);
+  }
+  return mode;
 }
 
 bool Supervisor::OnOperator(OperatorCommand command, bool processes_healthy,

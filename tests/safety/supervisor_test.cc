@@ -181,6 +181,44 @@ TEST(Supervisor, OperatorHoldNeedsNoReset) {
   EXPECT_TRUE(Do(&s, OperatorCommand::kResume));
 }
 
+// HOLD brakes (the safe stop, drive on) for hold_brake_s of stack time from
+// its first step, then turns the drive off (the lead screws hold) until the
+// operator resumes; resume ramps with the drive on again.
+TEST(Supervisor, HoldBrakesThenTurnsTheDriveOff) {
+  SupervisorConfig c = Config(0.0);
+  c.hold_brake_s = 0.05;
+  Supervisor s(c);
+  s.OnStep(Good(0));
+  ASSERT_TRUE(Do(&s, OperatorCommand::kArm));
+  s.OnStep(Good(1));
+  ASSERT_EQ(s.state(), SupervisorState::kArmed);
+  ASSERT_TRUE(Do(&s, OperatorCommand::kHold));
+  int64_t k = 2;
+  for (; k < 2 + 50; ++k) {
+    const SupervisorMode m = s.OnStep(Good(k));
+    EXPECT_EQ(m.state, SupervisorState::kHold);
+    EXPECT_FALSE(m.drive_off()) << "braking, at step " << k;
+  }
+  for (; k < 200; ++k) {
+    const SupervisorMode m = s.OnStep(Good(k));
+    EXPECT_EQ(m.state, SupervisorState::kHold);
+    EXPECT_TRUE(m.hold_locked);
+    EXPECT_TRUE(m.drive_off()) << "still braking, at step " << k;
+  }
+  ASSERT_TRUE(Do(&s, OperatorCommand::kResume));
+  EXPECT_FALSE(s.OnStep(Good(k++)).drive_off());
+  // A second HOLD brakes again from its own first step.
+  ASSERT_TRUE(Do(&s, OperatorCommand::kHold));
+  EXPECT_FALSE(s.OnStep(Good(k++)).drive_off());
+  // Brake only: HOLD never turns the drive off.
+  c.hold_drive_off = false;
+  Supervisor brake_only(c);
+  brake_only.OnStep(Good(0));
+  ASSERT_TRUE(Do(&brake_only, OperatorCommand::kArm));
+  ASSERT_TRUE(Do(&brake_only, OperatorCommand::kHold));
+  for (k = 1; k < 200; ++k) EXPECT_FALSE(brake_only.OnStep(Good(k)).drive_off());
+}
+
 TEST(Supervisor, EstopLatchesFromAnyStateAndResetDisarms) {
   for (const bool armed : {false, true}) {
     Supervisor s(Config(0.0));

@@ -57,6 +57,10 @@ LogSamples ReadLogSamples(const std::string& log_path, const std::string& state_
       ++out.unanswered_states;
       continue;
     }
+    if ((c->second.flags & force_command_t::FLAG_DRIVE_OFF) != 0) {
+      ++out.drive_off_states;
+      continue;
+    }
     IdentificationSample sample;
     sample.utime = sample_utime;
     sample.q = Vector6Of(s.q);

@@ -14,6 +14,9 @@ struct LogSamples {
   long unusable_states = 0;                   ///< of those: not valid, diverged or initialising
   long commands = 0;                          ///< force_command_t messages on the command channel
   long unanswered_states = 0;                 ///< usable states no command answered (not recorded)
+  /// Usable states answered with the actuators off: the legs were held by
+  /// their lead screws, so the commanded zero is not the force that acted.
+  long drive_off_states = 0;
 };
 
 /// Reads `log_path`: state_t on `state_channel` (the estimate, or the ground

@@ -127,10 +127,10 @@ int Identify(const Options& o) {
   const stewart::identify::LogSamples log =
       stewart::identify::ReadLogSamples(log_path, state_channel, config.lcm.channels.command_safe);
   spdlog::info(
-      "{}: {} states on {} ({} unusable, {} without a recorded command), {} safe commands; {} "
-      "paired samples",
-      log_path, log.states, state_channel, log.unusable_states, log.unanswered_states, log.commands,
-      log.samples.size());
+      "{}: {} states on {} ({} unusable, {} without a recorded command, {} answered with the "
+      "actuators off), {} safe commands; {} paired samples",
+      log_path, log.states, state_channel, log.unusable_states, log.unanswered_states,
+      log.drive_off_states, log.commands, log.samples.size());
   stewart::identify::InertialFitOptions fit_options;
   fit_options.window_s = o.window_s;
   const stewart::identify::InertialFit fit = stewart::identify::FitInertialParameters(
