@@ -94,6 +94,9 @@ SafetyConfig ParseSafetyConfig(const ConfigNode& safety) {
   if (safety.Has("per_period_angular_step_radps")) {
     s.per_period_angular_step_radps = safety.NonNegativeDouble("per_period_angular_step_radps");
   }
+  if (safety.Has("check_each_barrier")) {
+    s.check_each_barrier = safety.Bool("check_each_barrier");
+  }
   return s;
 }
 

@@ -78,11 +78,19 @@ void RunFullStep(benchmark::State& state, const SafetyConfig& safety,
   SafetyFilter filter(DefaultStackConfig().platform, safety, DefaultStackConfig().actuators,
                       reference);
   SafetyDiagnostics d;
+  // The share of the set whose answer the per-barrier check replaced.
+  int replaced = 0;
+  for (const Sample& x : Samples()) {
+    filter.Step(x.q, x.qd, x.f_des, &d);
+    replaced += (d.flags & kFlagPerBarrier) ? 1 : 0;
+  }
   size_t i = 0;
   for (auto _ : state) {
     const Sample& x = Samples()[i++ & 255];
     benchmark::DoNotOptimize(filter.Step(x.q, x.qd, x.f_des, &d));
   }
+  state.counters["per_barrier_share"] =
+      static_cast<double>(replaced) / static_cast<double>(Samples().size());
 }
 
 // (a) the closed form given the model terms.
@@ -114,6 +122,17 @@ void BM_ClosedFormFullStep(benchmark::State& state) {
   RunFullStep(state, DefaultStackConfig().safety);
 }
 BENCHMARK(BM_ClosedFormFullStep);
+
+// (b) without the per-barrier check, and without it and the leg-stroke
+// barriers (the shipped config before both, docs/safety.md "Each barrier
+// checked").
+void BM_ClosedFormFullStepUnchecked(benchmark::State& state) {
+  SafetyConfig s = DefaultStackConfig().safety;
+  s.check_each_barrier = false;
+  s.leg_stroke.enabled = state.range(0) != 0;
+  RunFullStep(state, s);
+}
+BENCHMARK(BM_ClosedFormFullStepUnchecked)->ArgName("leg_stroke")->Arg(1)->Arg(0);
 
 // (b) without the per-period bound on the nominal (nominal_bound.h), and
 // without it and the force limits (the shipped config before both).

@@ -88,6 +88,7 @@ SafetyFilter::SafetyFilter(const PlatformParams& platform, const SafetyConfig& s
       fallback_(safety.fallback),
       stop_time_s_(safety.stop_time_s),
       use_disturbance_(safety.use_disturbance_estimate),
+      check_each_barrier_(safety.check_each_barrier),
       nominal_max_accel_(NominalAccelerationBound(safety.sample_period_s,
                                                   safety.per_period_velocity_step_mps,
                                                   safety.per_period_angular_step_radps)),
@@ -197,24 +198,26 @@ Vector6d SafetyFilter::StepWithTerms(const DynamicsTerms& terms, const Vector6d&
     ok = BarriersFinite(d->barriers) &&
          (metric_ == CorrectionMetric::kForce || ws.barrier.inertia_valid);
   }
+  bool solved = false;
   if (ok && force_limits_ && variant_ == SafetyVariant::kClosedForm) {
     // The box only matters when it cuts the unlimited optimum off: a convex
     // QP's optimum that satisfies constraints left out is the optimum with
     // them. The closed form (~0.3 us) first; the active set (~1.5 us) only
     // when F* leaves the box.
     SolveUnlimited(in, ws, d);
-    if (!d->infeasible && (d->f_safe.array().abs() <= force_limit_n_).all()) {
-      FinishStep(f_des, d);
-      return d->f_safe;
+    solved = !d->infeasible && (d->f_safe.array().abs() <= force_limit_n_).all();
+    if (!solved) {
+      d->infeasible = false;
+      d->mu_p = d->mu_v = 0.0;
     }
-    d->infeasible = false;
-    d->mu_p = d->mu_v = 0.0;
   }
-  if (ok) {
+  bool metric_map_ready = false;
+  if (ok && !solved) {
     if (variant_ == SafetyVariant::kQpReference || variant_ == SafetyVariant::kUncomposed ||
         force_limits_) {
       // These pose the QP in y = T^-1 F, so they need T itself.
       ok = ComputeMetricMap(terms, ws.barrier, &ws.metric_map);
+      metric_map_ready = ok;
       if (ok && variant_ == SafetyVariant::kQpReference) {
         SolveReference(in, &ws, d);
       } else if (ok && variant_ == SafetyVariant::kUncomposed) {
@@ -225,6 +228,23 @@ Vector6d SafetyFilter::StepWithTerms(const DynamicsTerms& terms, const Vector6d&
     } else {
       SolveUnlimited(in, ws, d);
     }
+  }
+  ok = ok && d->f_safe.allFinite();
+  // The QP reference checks as the closed form does, so that it reproduces
+  // the filter's answer (it stands in for the composed solve only).
+  const bool checked_variant =
+      variant_ == SafetyVariant::kClosedForm || variant_ == SafetyVariant::kQpReference;
+  if (ok && check_each_barrier_ && checked_variant && BreaksABarrierCondition(in, ws, d->f_safe)) {
+    // One composed condition bounds only a weighted sum of the barrier
+    // derivatives: where the weights of two nearly active barriers trade
+    // places from one step to the next, the answer may accelerate freely
+    // along another limited axis (docs/safety.md, "Each barrier checked").
+    d->infeasible = false;
+    d->mu_p = d->mu_v = 0.0;
+    d->mu_force.setZero();
+    d->flags |= kFlagPerBarrier;
+    ok = metric_map_ready || ComputeMetricMap(terms, ws.barrier, &ws.metric_map);
+    if (ok) SolveUncomposed(in, &ws, d);
     ok = ok && d->f_safe.allFinite();
   }
   if (!ok) {
@@ -325,6 +345,45 @@ bool SafetyFilter::ComputeMetricMap(const DynamicsTerms& terms, const BarrierInt
   }
   if (AccelerationMetricMap(terms.H, x.inertia, map)) return true;
   workspace_.leg_jacobian_degenerate = true;
+  return false;
+}
+
+bool SafetyFilter::BreaksABarrierCondition(const StepInput& in, const FilterWorkspace& ws,
+                                           const Vector6d& f) const {
+  const BarrierEvaluation& b = in.barriers;
+  const ConstraintSet& c = constraints_;
+  if (c.num_velocity > 0 && !ws.barrier.inertia_valid) return false;  // no M^-1: not posable
+  // Each condition is affine in F: Psi_i(F) = Psi_i(F_nom) + alpha_i g_i^T dF,
+  // as posed by PoseUncomposedQp.
+  const Vector6d df = f - in.f_des;
+  const Vector6d h_df = in.terms.H * df;  // generalized force of the change
+  if (c.num_position > 0 && !b.outside_position_set) {
+    const double dpower = -in.qd.dot(h_df);  // g_p^T dF, g_p = -H^T qd (W)
+    for (int i = 0; i < c.num_position; ++i) {
+      const size_t k = static_cast<size_t>(i);
+      const double alpha = c.position[k].alpha;
+      const double at_nominal = c.position_rate_per_s * b.alpha_h_position[k] +
+                                alpha * b.dh_position[k] - c.position_margin;
+      const double change = alpha * dpower;
+      const double tolerance =
+          kPerBarrierRelTol * (std::fabs(at_nominal) + std::fabs(change) + c.position_margin);
+      if (at_nominal + change < -tolerance) return true;
+    }
+  }
+  if (c.num_velocity > 0) {
+    Rhs6<1> dqdd = h_df;  // M^-1 H dF (m/s^2, rad/s^2)
+    ws.barrier.inertia.SolveInPlace<1>(&dqdd);
+    for (int i = 0; i < c.num_velocity; ++i) {
+      const size_t k = static_cast<size_t>(i);
+      const VelocityBarrierSpec& spec = c.velocity[k];
+      const double at_nominal = c.velocity_rate_per_s * b.alpha_h_velocity[k] +
+                                spec.alpha_v * b.dh_velocity[k] - c.velocity_margin;
+      const double change = spec.alpha_v * spec.sign * dqdd(spec.axis);
+      const double tolerance =
+          kPerBarrierRelTol * (std::fabs(at_nominal) + std::fabs(change) + c.velocity_margin);
+      if (at_nominal + change < -tolerance) return true;
+    }
+  }
   return false;
 }
 

@@ -196,6 +196,7 @@ SafetyOutput SafetyProcess::Filter(const StateSample& state, const ForceCommand&
   if (diagnostics_.flags & kFlagInvalidInput) counters_->Reject("invalid_nominal");
   if (diagnostics_.flags & kFlagOutsideSafeSet) counters_->Count("outside_safe_set");
   if (diagnostics_.flags & kFlagNominalBounded) counters_->Count("nominal_bounded");
+  if (diagnostics_.flags & kFlagPerBarrier) counters_->Count("per_barrier");
   return Supervise(state, f_safe, nominal.sample_utime, 0);
 }
 

@@ -267,6 +267,7 @@ json SummarizeCampaign(const CsvTable& runs, const json& meta, double tolerance)
   s["runs_with_fallback"] = count_positive("fallback_ticks");
   s["runs_with_infeasible"] = count_positive("infeasible_ticks");
   s["runs_with_nominal_bounded"] = count_positive("nominal_bounded_ticks");
+  s["runs_with_per_barrier"] = count_positive("per_barrier_ticks");
   s["runs_with_endstop_hits"] = count_positive("endstop_hits");
   s["endstop_hits"] = total("endstop_hits");
   s["runs_with_stiff_fallbacks"] = count_positive("stiff_fallbacks");
@@ -374,6 +375,7 @@ std::string SummaryMarkdown(const json& s) {
   o << "- runs with fallback ticks: " << s["runs_with_fallback"].get<long>()
     << "; with infeasible ticks: " << s["runs_with_infeasible"].get<long>()
     << "; with the nominal bounded per period: " << s.value("runs_with_nominal_bounded", 0L)
+    << "; with per-barrier answers: " << s.value("runs_with_per_barrier", 0L)
     << "; with end-stop hits: " << s["runs_with_endstop_hits"].get<long>() << " ("
     << s["endstop_hits"].get<double>()
     << " hits); plant intervals integrated by the stiff "

@@ -207,6 +207,7 @@ ClosedLoopSummary RunClosedLoop(const StackConfig& config, const Scenario& scena
       ++out.case_ticks[static_cast<size_t>(d->filter_case)];
       if (d->infeasible) ++out.infeasible_ticks;
       if (d->flags & safety::kFlagNominalBounded) ++out.nominal_bounded_ticks;
+      if (d->flags & safety::kFlagPerBarrier) ++out.per_barrier_ticks;
     }
     if (has_safe && safe.fallback_reason != 0) ++out.fallback_ticks;
     const double f_max = f_safe.cwiseAbs().maxCoeff();
@@ -289,10 +290,10 @@ std::string FormatSummary(const StackConfig& config, const ClosedLoopSummary& s)
   std::snprintf(line, sizeof line,
                 "worst excess %.3g (%s); ticks %ld; cases none/p/v/both/infeasible/fallback "
                 "%ld/%ld/%ld/%ld/%ld/%ld; saturated ticks %ld, max |F*| %.1f N; "
-                "nominal bounded ticks %ld\n",
+                "nominal bounded ticks %ld, per-barrier ticks %ld\n",
                 s.max_limit_excess, s.max_limit_excess_name.c_str(), s.ticks, s.case_ticks[0],
                 s.case_ticks[1], s.case_ticks[2], s.case_ticks[3], s.case_ticks[4], s.case_ticks[5],
-                s.saturated_ticks, s.max_force_n, s.nominal_bounded_ticks);
+                s.saturated_ticks, s.max_force_n, s.nominal_bounded_ticks, s.per_barrier_ticks);
   o << line;
   std::snprintf(line, sizeof line,
                 "estimator: rms |q-q_true| %.3g m, rms |qd-qd_true| %.3g m/s, re-inits %ld; "

@@ -2,10 +2,11 @@
 // (SUNDIALS, friction, saturation), noisy sensors, EKF, controller, filter.
 // Every configured limit must hold on ground truth within the tolerance
 // docs/safety.md states (1 mm, 1 mm/s), for several noise seeds; and the
-// paper's force metric must fail where the acceleration metric holds, which
-// is why the config chooses the latter.
+// paper's force metric tilts the platform where the acceleration metric does
+// not, which is why the config chooses the latter.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <string>
 
 #include "stewart/config/default_config.h"
@@ -76,17 +77,30 @@ TEST(PaperScenario, TracksTheSetpointsTheLimitsAllow) {
 
 TEST(CorrectionMetric, ForceMetricLetsRotationsAbsorbTheCorrection) {
   // The paper's ||F - F_des||: on this light platform the cheapest force
-  // change that meets the composed velocity condition tilts the platform;
-  // the tilt grows until the limits are lost. 12 s of the paper scenario
-  // with perfect state shows it (docs/safety.md, "Correction metric").
+  // change that meets the composed velocity condition tilts the platform.
+  // 12 s of the paper scenario with perfect state shows it (docs/safety.md,
+  // "Correction metric"). With the paper's constraints alone (no leg-stroke
+  // barriers) and the composed closed form alone (no per-barrier check) the
+  // tilt grows until the limits are lost; the shipped checks keep the limits,
+  // but the platform still tilts by a tenth of a radian.
+  const auto tilt = [](const ClosedLoopSummary& s) {
+    return std::max(s.q_max.tail<3>().cwiseAbs().maxCoeff(),
+                    s.q_min.tail<3>().cwiseAbs().maxCoeff());
+  };
   StackConfig force_metric = DefaultStackConfig();
   force_metric.safety.correction_metric = CorrectionMetric::kForce;
-  const ClosedLoopSummary bad = RunScenario(force_metric, "paper", 1, true, 12.0);
+  StackConfig paper_constraints = force_metric;
+  paper_constraints.safety.check_each_barrier = false;
+  paper_constraints.safety.leg_stroke.enabled = false;
+  const ClosedLoopSummary bad = RunScenario(paper_constraints, "paper", 1, true, 12.0);
+  EXPECT_GT(bad.max_limit_excess, 10 * kLimitTolerance) << FormatSummary(paper_constraints, bad);
+  EXPECT_GT(tilt(bad), 0.1);
+  const ClosedLoopSummary tilted = RunScenario(force_metric, "paper", 1, true, 12.0);
+  EXPECT_LE(tilted.max_limit_excess, kLimitTolerance) << FormatSummary(force_metric, tilted);
+  EXPECT_GT(tilt(tilted), 0.1) << FormatSummary(force_metric, tilted);
   const ClosedLoopSummary good = RunScenario(DefaultStackConfig(), "paper", 1, true, 12.0);
-  EXPECT_GT(bad.max_limit_excess, 10 * kLimitTolerance) << FormatSummary(force_metric, bad);
-  EXPECT_GT(bad.q_max.tail<3>().cwiseAbs().maxCoeff() + bad.q_min.tail<3>().cwiseAbs().maxCoeff(),
-            0.1);
   EXPECT_LE(good.max_limit_excess, kLimitTolerance) << FormatSummary(DefaultStackConfig(), good);
+  EXPECT_LT(tilt(good), 0.05) << FormatSummary(DefaultStackConfig(), good);
 }
 
 TEST(LegFriction, UnmodelledFrictionCostsTracking) {

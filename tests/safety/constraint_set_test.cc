@@ -9,9 +9,11 @@
 namespace stewart::safety::test {
 namespace {
 
-TEST(ConstraintSet, DefaultConfigIsThePapersUpperLimits) {
+TEST(ConstraintSet, DefaultConfigIsThePapersUpperLimitsAndTheLegStrokes) {
   const ConstraintSet c = BuildConstraintSet(DefaultConfig().platform, DefaultConfig().safety);
-  EXPECT_EQ(c.num_position, 3);
+  // x, y, z upper, then a lower and an upper stroke barrier per leg.
+  EXPECT_EQ(c.num_position, 3 + 2 * kNumLegs);
+  EXPECT_EQ(c.position[3].source, PositionSource::kLegLength);
   // The three velocity limits, then one recovery barrier per position limit.
   EXPECT_EQ(c.num_velocity, 6);
   EXPECT_EQ(c.position[2].name, "z_upper");

@@ -29,10 +29,14 @@ TEST(LaunchExit, PipedIntoHeadLeavesNoProcessBehind) {
   ASSERT_NE(Shell(kLaunchedProcesses), 0) << "processes of an earlier run are still up";
   const std::string run = ::testing::TempDir() + "launch_exit_run";
   const std::string head = ::testing::TempDir() + "launch_exit_head.txt";
+  // The reader keeps the banner's first three lines, as `head -3` would, but
+  // goes away only at launch.sh's first progress line ("  t = ..."), once
+  // every process is up: `head -3` itself raced the start-up (launch.sh died
+  // at its next write, before or after starting the stack, by timing).
   const std::string launch = "tools/launch.sh --no-build --no-report --duration 30 --out " +
                              ShellQuote(run) + " --lcm-url " +
-                             ShellQuote(PrivateLcmUrl(kLaunchExitPort)) + " | head -3 >" +
-                             ShellQuote(head);
+                             ShellQuote(PrivateLcmUrl(kLaunchExitPort)) +
+                             " | sed -n '1,3p; /^  t = /q' >" + ShellQuote(head);
   const int code = Shell("cd " + ShellQuote(STEWART_SOURCE_DIR) +
                          " && STEWART_BUILD_DIR=" + ShellQuote(STEWART_BUILD_DIR) + " flock " +
                          ShellQuote(std::string(STEWART_BUILD_DIR) + "/stack_launch.lock") +

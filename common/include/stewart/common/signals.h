@@ -67,5 +67,8 @@ constexpr int32_t kCommandDriveOff = 256;
 /// The nominal asked for more acceleration than one sample period allows;
 /// the filter solved its conditions for the scaled nominal.
 constexpr int32_t kCommandNominalBounded = 512;
+/// The composed filter's answer broke one barrier's own condition; the
+/// un-composed QP answered instead.
+constexpr int32_t kCommandPerBarrier = 1024;
 
 }  // namespace stewart

@@ -25,7 +25,8 @@ static_assert(kCommandFilterActive == force_command_t::FLAG_FILTER_ACTIVE &&
                   kCommandForceLimited == force_command_t::FLAG_FORCE_LIMITED &&
                   kCommandOutsideSafeSet == force_command_t::FLAG_OUTSIDE_SAFE_SET &&
                   kCommandDriveOff == force_command_t::FLAG_DRIVE_OFF &&
-                  kCommandNominalBounded == force_command_t::FLAG_NOMINAL_BOUNDED,
+                  kCommandNominalBounded == force_command_t::FLAG_NOMINAL_BOUNDED &&
+                  kCommandPerBarrier == force_command_t::FLAG_PER_BARRIER,
               "signals.h and force_command_t.FLAG_* must agree");
 
 /// For each message, the library signal it carries and the fields both share

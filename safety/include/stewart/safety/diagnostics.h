@@ -23,6 +23,9 @@ enum FilterFlag : std::int32_t {
   /// F_des asked for more acceleration than one sample period allows
   /// (nominal_bound.h): the conditions were solved for the scaled nominal.
   kFlagNominalBounded = 512,
+  /// The composed closed form's answer broke one barrier's own condition;
+  /// the un-composed QP answered this step (SafetyConfig::check_each_barrier).
+  kFlagPerBarrier = 1024,
 };
 
 struct SafetyDiagnostics {

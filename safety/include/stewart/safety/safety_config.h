@@ -107,6 +107,11 @@ struct SafetyConfig {
   /// The plant's zero-order-hold period T (s): 1 / sensors.rate_hz, set by
   /// ParseStackConfig. 0 (a config built in code) turns the bound off.
   double sample_period_s = 0.0;
+  /// Optional key `check_each_barrier` (default true), variants closed_form
+  /// and qp: the composed answer is checked against every barrier's own
+  /// condition, and where it breaks one the un-composed QP answers that step
+  /// (kFlagPerBarrier; docs/safety.md, "Each barrier checked").
+  bool check_each_barrier = true;
 };
 
 inline std::string ToString(SafetyVariant variant) {

@@ -40,6 +40,12 @@ constexpr double kMaxLegJacobianCondition = 1e8;
 /// closed form (1e-9), far above what rounding leaves.
 constexpr double kReferenceActiveRelTol = 1e-10;
 
+/// Variant closed_form with check_each_barrier: a barrier's own condition at
+/// the composed answer F* below -this x (the magnitude of its terms) counts as
+/// broken. Far above the rounding of the composed solve, far below any
+/// physical margin.
+constexpr double kPerBarrierRelTol = 1e-9;
+
 class SafetyFilter {
  public:
   /// Throws InputError (a std::invalid_argument naming the config key) for an
@@ -126,6 +132,8 @@ class SafetyFilter {
   void set_variant(SafetyVariant variant);
   SafetyVariant variant() const { return variant_; }
   void set_force_limits(bool enabled) { force_limits_ = enabled; }
+  void set_check_each_barrier(bool enabled) { check_each_barrier_ = enabled; }
+  bool check_each_barrier() const { return check_each_barrier_; }
   bool force_limits() const { return force_limits_; }
   const ConstraintSet& constraints() const { return constraints_; }
   CorrectionMetric correction_metric() const { return metric_; }
@@ -162,6 +170,10 @@ class SafetyFilter {
   bool PoseUncomposedQp(const StepInput& in, ConditionGroups groups, const FilterWorkspace& ws,
                         UncomposedQpData* out) const;
   void SolveUncomposed(const StepInput& in, FilterWorkspace* ws, SafetyDiagnostics* d) const;
+  /// True when F breaks some barrier's own condition Psi_i(F) >= 0 (the rows
+  /// of PoseUncomposedQp) beyond rounding (kPerBarrierRelTol).
+  bool BreaksABarrierCondition(const StepInput& in, const FilterWorkspace& ws,
+                               const Vector6d& f) const;
   /// The report of a QP solution, for every variant that solves one: from the
   /// group multipliers d->mu_p, d->mu_v, the case; from the force-limit rows'
   /// multipliers (lower, upper per leg; nullptr when none were posed or the
@@ -184,6 +196,7 @@ class SafetyFilter {
   SafetyFallback fallback_;
   double stop_time_s_;
   bool use_disturbance_;
+  bool check_each_barrier_;
   Vector6d nominal_max_accel_;
   bool bound_nominal_;
   ReferenceQpSolver* reference_;

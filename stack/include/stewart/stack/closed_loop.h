@@ -61,6 +61,9 @@ struct ClosedLoopSummary {
   long infeasible_ticks = 0;
   /// Ticks whose nominal exceeded the per-period bound (FLAG_NOMINAL_BOUNDED).
   long nominal_bounded_ticks = 0;
+  /// Ticks the un-composed QP answered because the composed answer broke a
+  /// barrier's own condition (FLAG_PER_BARRIER).
+  long per_barrier_ticks = 0;
   long fallback_ticks = 0;        ///< ticks the safety process answered with its fallback
   long endstop_hits = 0;          ///< legs entering an end-stop (plant)
   long stiff_fallbacks = 0;       ///< plant intervals the BDF fallback integrated (Plant)
