@@ -682,7 +682,7 @@ def main():
         axes[4, 1].plot(td, diag["nominal_scale"], lw=0.8)
     axes[4, 1].set_ylabel("nominal scale s\n(1: within the per-period bound)", fontsize=8)
     flag_bits = ((4, "fallback"), (2, "infeasible"), (128, "outside"), (256, "drive off"),
-                 (512, "bounded"))
+                 (512, "bounded"), (1024, "per barrier"))
     if diag is not None and "flags" in diag:
         flags = diag["flags"].astype(int)
         for row, (bit, _) in enumerate(flag_bits):
