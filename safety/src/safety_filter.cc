@@ -239,10 +239,12 @@ Vector6d SafetyFilter::StepWithTerms(const DynamicsTerms& terms, const Vector6d&
     // derivatives: where the weights of two nearly active barriers trade
     // places from one step to the next, the answer may accelerate freely
     // along another limited axis (docs/safety.md, "Each barrier checked").
+    // The replaced answer's report goes with it (a safe stop or an active
+    // force limit of the composed solve); SolveUncomposed reports its own.
     d->infeasible = false;
     d->mu_p = d->mu_v = 0.0;
     d->mu_force.setZero();
-    d->flags |= kFlagPerBarrier;
+    d->flags = (d->flags & ~(kFlagFallback | kFlagForceLimited)) | kFlagPerBarrier;
     ok = metric_map_ready || ComputeMetricMap(terms, ws.barrier, &ws.metric_map);
     if (ok) SolveUncomposed(in, &ws, d);
     ok = ok && d->f_safe.allFinite();
@@ -360,11 +362,8 @@ bool SafetyFilter::BreaksABarrierCondition(const StepInput& in, const FilterWork
   if (c.num_position > 0 && !b.outside_position_set) {
     const double dpower = -in.qd.dot(h_df);  // g_p^T dF, g_p = -H^T qd (W)
     for (int i = 0; i < c.num_position; ++i) {
-      const size_t k = static_cast<size_t>(i);
-      const double alpha = c.position[k].alpha;
-      const double at_nominal = c.position_rate_per_s * b.alpha_h_position[k] +
-                                alpha * b.dh_position[k] - c.position_margin;
-      const double change = alpha * dpower;
+      const double at_nominal = OwnPositionCondition(c, b, i);
+      const double change = c.position[static_cast<size_t>(i)].alpha * dpower;
       const double tolerance =
           kPerBarrierRelTol * (std::fabs(at_nominal) + std::fabs(change) + c.position_margin);
       if (at_nominal + change < -tolerance) return true;
@@ -374,10 +373,8 @@ bool SafetyFilter::BreaksABarrierCondition(const StepInput& in, const FilterWork
     Rhs6<1> dqdd = h_df;  // M^-1 H dF (m/s^2, rad/s^2)
     ws.barrier.inertia.SolveInPlace<1>(&dqdd);
     for (int i = 0; i < c.num_velocity; ++i) {
-      const size_t k = static_cast<size_t>(i);
-      const VelocityBarrierSpec& spec = c.velocity[k];
-      const double at_nominal = c.velocity_rate_per_s * b.alpha_h_velocity[k] +
-                                spec.alpha_v * b.dh_velocity[k] - c.velocity_margin;
+      const VelocityBarrierSpec& spec = c.velocity[static_cast<size_t>(i)];
+      const double at_nominal = OwnVelocityCondition(c, b, i);
       const double change = spec.alpha_v * spec.sign * dqdd(spec.axis);
       const double tolerance =
           kPerBarrierRelTol * (std::fabs(at_nominal) + std::fabs(change) + c.velocity_margin);

@@ -78,8 +78,7 @@ bool SafetyFilter::PoseUncomposedQp(const StepInput& in, ConditionGroups groups,
       const size_t k = static_cast<size_t>(i);
       const double alpha = c.position[k].alpha;
       // alpha_i (dh_i + h_i) - delta_p at F_des (+ friction: barriers.h).
-      const double psi = c.position_rate_per_s * b.alpha_h_position[k] + alpha * b.dh_position[k] -
-                         c.position_margin;
+      const double psi = OwnPositionCondition(c, b, i);
       const ConditionRow r = AppendConditionRow(psi, alpha * g, &qp);
       posable = posable && r.posable;
       rows.position_row[k] = r.row;
@@ -96,8 +95,7 @@ bool SafetyFilter::PoseUncomposedQp(const StepInput& in, ConditionGroups groups,
     for (int i = 0; i < c.num_velocity; ++i) {
       const size_t k = static_cast<size_t>(i);
       const VelocityBarrierSpec& s = c.velocity[k];
-      const double psi = c.velocity_rate_per_s * b.alpha_h_velocity[k] +
-                         s.alpha_v * b.dh_velocity[k] - c.velocity_margin;
+      const double psi = OwnVelocityCondition(c, b, i);
       const ConditionRow r = AppendConditionRow(psi, (s.alpha_v * s.sign) * g.col(s.axis), &qp);
       posable = posable && r.posable;
       rows.velocity_row[k] = r.row;

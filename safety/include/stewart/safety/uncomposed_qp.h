@@ -17,6 +17,7 @@
 // rows T^T alpha_i g_i / |T^T alpha_i g_i|.
 #include <array>
 
+#include "stewart/safety/barriers.h"
 #include "stewart/safety/constraint_set.h"
 #include "stewart/safety/projection_qp.h"
 
@@ -30,6 +31,20 @@ using UncomposedQpResult = ProjectionResultN<kMaxUncomposedQpRows>;
 
 extern template ProjectionResultN<kMaxUncomposedQpRows> SolveProjectionQp(
     const ProjectionQpN<kMaxUncomposedQpRows>&);
+
+/// Psi_i at the nominal force of position barrier k: alpha_k (dh_k + gamma_p
+/// h_k) - delta_p (W), with dh_k at F_des plus friction (barriers.h).
+inline double OwnPositionCondition(const ConstraintSet& c, const BarrierEvaluation& b, int k) {
+  const size_t i = static_cast<size_t>(k);
+  return c.position_rate_per_s * b.alpha_h_position[i] + c.position[i].alpha * b.dh_position[i] -
+         c.position_margin;
+}
+/// The same for velocity barrier k (m/s^2).
+inline double OwnVelocityCondition(const ConstraintSet& c, const BarrierEvaluation& b, int k) {
+  const size_t i = static_cast<size_t>(k);
+  return c.velocity_rate_per_s * b.alpha_h_velocity[i] + c.velocity[i].alpha_v * b.dh_velocity[i] -
+         c.velocity_margin;
+}
 
 /// Which QP row holds which barrier (SafetyFilter::BuildUncomposedQp).
 struct UncomposedQpRows {
