@@ -565,15 +565,21 @@ void OperatorCommand(const char* name, int port, const char* verb, int8_t comman
   EXPECT_EQ(stack.Ctl({verb}), 0);
   const double ctl_ms = 1e-3 * double(WallUs() - started);
   int64_t fault = -1;
-  for (const auto& op : stack.bus.operators) {
-    if (op.msg.command == command) {
-      // Its send time (the console's clock, this host's): the safety
-      // process can receive it, act and announce a few us before the
-      // test's own copy is timestamped.
-      fault = op.msg.utime;
-      break;
+  const auto find_command = [&] {
+    for (const auto& op : stack.bus.operators) {
+      if (op.msg.command == command) {
+        // Its send time (the console's clock, this host's): the safety
+        // process can receive it, act and announce a few us before the
+        // test's own copy is timestamped.
+        fault = op.msg.utime;
+        return true;
+      }
     }
-  }
+    return false;
+  };
+  // stewart_ctl can exit before this process has read its command from the
+  // socket (a loaded machine schedules the test late): read on until it is.
+  stack.PumpUntil(find_command, 1.0);
   ASSERT_GT(fault, 0) << "no " << verb << " on the operator channel";
   stack.PumpUntil([&] { return stack.Measure(fault, state).hold_wall_ms.has_value(); }, 1.0);
   stack.Pump(0.1);
