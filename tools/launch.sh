@@ -338,7 +338,18 @@ if ((DO_LOG)); then
   fi
   echo "   recording:  $LOG"
 fi
-if ((SPY)); then start lcm-spy "$ROOT/tools/lcm-spy" --lcm-url="$URL"; fi
+if ((SPY)); then
+  # lcm-spy is a window: without a display it would die at once, its reason
+  # only in its log. Over ssh (--hosts) the observer host's display counts.
+  read -ra SPY_PREFIX <<<"$(on_host lcm-spy)"
+  if [[ -z ${DISPLAY:-} && ${SPY_PREFIX[0]:-} != ssh ]]; then
+    echo "launch: warning: --spy needs a display and DISPLAY is not set: lcm-spy not started" \
+      "(headless: xvfb-run tools/lcm-spy --lcm-url='$URL', or lcm-spy on a machine with a" \
+      "display on the same network; docs/operations.md)" >&2
+  else
+    start lcm-spy "$ROOT/tools/lcm-spy" --lcm-url="$URL"
+  fi
+fi
 if ((VIEWER)); then
   # Normal scheduling, and off the loop's CPU when it has one: it only
   # watches the bus.
@@ -392,13 +403,21 @@ steal_ticks() { awk '/^cpu /{ print $9; exit }' /proc/stat 2>/dev/null || echo 0
 STEAL0=$(steal_ticks)
 LOAD0=$(cut -d' ' -f1 /proc/loadavg 2>/dev/null || echo "?")
 LAST_PROGRESS=""
+declare -A OPTIONAL_GONE=()
 while :; do
   for i in "${!PIDS[@]}"; do
     name=${NAMES[$i]} pid=${PIDS[$i]}
     if ! kill -0 "$pid" 2>/dev/null; then
       status=0; wait "$pid" || status=$?
       if [[ $name == "$PLANT_NAME" && $status -eq 0 ]]; then break 2; fi
-      [[ $name == monitor || $name == lcm-spy || $name == viewer ]] && continue
+      if [[ $name == monitor || $name == lcm-spy || $name == viewer ]]; then
+        # Optional: the run goes on, but the user is told once.
+        if [[ -z ${OPTIONAL_GONE[$name]:-} ]]; then
+          OPTIONAL_GONE[$name]=1
+          echo "launch: warning: $name exited ($status); the run goes on without it: $(tail -n 1 "$OUT/$name.log" 2>/dev/null)" >&2
+        fi
+        continue
+      fi
       fail "$name"
     fi
   done

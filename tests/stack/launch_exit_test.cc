@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cstdlib>
 #include <string>
 #include <thread>
 
@@ -15,11 +16,12 @@
 namespace stewart::test {
 namespace {
 
-// This folder's private ports: 7820-7829, 7898, 7899. The two tests below
+// This folder's private ports: 7820-7829, 7898, 7899 (7829: LaunchSpy). The two tests below
 // run at the same time under ctest -j and must not share a port: the first
 // looks for (and kills) every process on its own.
 constexpr int kLaunchExitPort = 7898;
 constexpr int kReportShPort = 7899;
+constexpr int kSpyPort = 7829;
 
 // Matches the launched processes' command lines (their --lcm-url), not this
 // test's own shell, whose command line holds the pattern with brackets.
@@ -54,6 +56,24 @@ TEST(LaunchExit, PipedIntoHeadLeavesNoProcessBehind) {
   }
   EXPECT_TRUE(gone) << "processes started by tools/launch.sh are still running";
   if (!gone) Shell("pkill -KILL -f '239[.]255[.]76[.]67:789[8]'");
+}
+
+/// `--spy` on a host without a display: lcm-spy (a window) would die at
+/// once, its reason only in its own log; the run used to go on without a
+/// word. Now the user is told, and the run itself is unaffected.
+TEST(LaunchSpy, WithoutADisplayTheRunSaysSoAndGoesOn) {
+  const char* display = std::getenv("DISPLAY");
+  const std::string saved = display ? display : "";
+  ::unsetenv("DISPLAY");
+  const std::string run = ::testing::TempDir() + "launch_spy_run";
+  Shell("rm -rf " + ShellQuote(run));
+  const LaunchResult launch = RunLauncher("--no-build --no-report --duration 1 --spy", kSpyPort,
+                                          run, ::testing::TempDir() + "launch_spy.txt");
+  if (display) ::setenv("DISPLAY", saved.c_str(), 1);
+  ASSERT_EQ(launch.exit_code, 0) << LaunchFailure(launch);
+  const std::string out = ReadFile(launch.output_path);
+  EXPECT_NE(out.find("--spy needs a display and DISPLAY is not set"), std::string::npos) << out;
+  EXPECT_NE(out.find("xvfb-run tools/lcm-spy"), std::string::npos) << out;
 }
 
 std::string ReportSh(const std::string& args, int* code) {
