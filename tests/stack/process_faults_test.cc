@@ -1,5 +1,6 @@
-// Process faults on a running real-time stack: each of plant_sim, safety,
-// stewart_logger and (hardware mode) hw_emulator and hw_bridge is stopped (SIGSTOP, then
+// Process faults on a running real-time stack: each of plant_sim, estimator,
+// controller, safety, stewart_logger and (hardware mode) hw_emulator and
+// hw_bridge is stopped (SIGSTOP, then
 // SIGCONT) and killed (SIGKILL, then started again) at a random instant
 // once the supervisor is ARMED (seeded: the seed is printed, and
 // STEWART_FAULT_SEED=N repeats it). The real processes on a private URL
@@ -31,7 +32,7 @@
 // STEWART_SOAK_S=S repeats the faults of each test at random instants for S
 // seconds of wall time (default 0: once each, the CI's short profile).
 //
-// LCM ports 8020-8024 (this file owns 8020-8029), device UDP ports 8028
+// LCM ports 8020-8026 (this file owns 8020-8029), device UDP ports 8028
 // (hw_emulator) and 8029 (hw_bridge). Each test holds the build folder's
 // launcher lock: a real-time stack alone on the shared cores.
 #include <gtest/gtest.h>
@@ -72,6 +73,8 @@ constexpr int kPortSafety = 8021;
 constexpr int kPortLogger = 8022;
 constexpr int kPortHwEmulator = 8023;
 constexpr int kPortHwBridge = 8024;
+constexpr int kPortEstimator = 8025;
+constexpr int kPortController = 8026;
 constexpr int kDevicePort = 8028;  // hw_bridge binds kDevicePort + 1
 
 int64_t WallUs() {
@@ -216,12 +219,17 @@ class Stack {
   std::unique_ptr<test::ChildProcess> StartBridge() const {
     return std::make_unique<test::ChildProcess>(With({HW_BRIDGE_PATH}));
   }
+  std::unique_ptr<test::ChildProcess> StartController() const {
+    return std::make_unique<test::ChildProcess>(With({CONTROLLER_PATH, "--scenario", "paper"}));
+  }
+  std::unique_ptr<test::ChildProcess> StartEstimator() const {
+    return std::make_unique<test::ChildProcess>(With({ESTIMATOR_PATH}));
+  }
   void Start() {
     logger = StartLogger(false);
     safety = StartSafety();
-    controller =
-        std::make_unique<test::ChildProcess>(With({CONTROLLER_PATH, "--scenario", "paper"}));
-    estimator = std::make_unique<test::ChildProcess>(With({ESTIMATOR_PATH}));
+    controller = StartController();
+    estimator = StartEstimator();
     if (hardware_) {
       emulator = StartEmulator();
       bridge = StartBridge();
@@ -608,6 +616,58 @@ TEST(ProcessFaults, PlantSimStoppedAndKilled) {
               test::Describe(stack.bus.truth).c_str());
   test::ExpectWithinLimits(stack.bus.truth);
   ExpectTheLogHasEverySampleHeard(stack);
+}
+
+/// A process between the plant and the filter stopped and killed: the
+/// estimator (no state: no safe command, the actuators' command timeout; a
+/// restarted one starts over and is judged a restart, or its first
+/// estimates are not usable) or the controller (no nominal: the safety
+/// process's watchdog; a restarted one is judged a restart). Either way the
+/// supervisor holds within the heartbeat timeout, and after the operator's
+/// reset and resume the platform moves on.
+void LoopProcessStoppedAndKilled(const std::string& name, int port, uint64_t seed_stream) {
+  test::LauncherLock lock;
+  PrintSeed();
+  std::mt19937_64 rng(Seed() * 4 + seed_stream);
+  Stack stack(name, port, false);
+  stack.Start();
+  ASSERT_TRUE(stack.WaitArmed(10.0)) << "the stack did not arm";
+  const StackConfig& c = stack.config();
+  const bool estimator = name == "estimator";
+  std::unique_ptr<test::ChildProcess>* target = estimator ? &stack.estimator : &stack.controller;
+  const double hold_bound_ms =
+      1e3 * c.supervisor.heartbeat_timeout_s + 1e3 / c.lcm.health_rate_hz + 150.0;
+  const auto started = std::chrono::steady_clock::now();
+  int rounds = 0;
+  do {
+    for (const bool kill : {false, true}) {
+      const std::string what = name + (kill ? " kill" : " stop");
+      const FaultRun run = InjectFault(
+          stack, &rng, name, target, kill, StopSeconds(c),
+          [&] { return estimator ? stack.StartEstimator() : stack.StartController(); },
+          [](const SafeTimes& t) { return t.hold_ms.has_value(); }, StopSeconds(c) + 2.0);
+      ASSERT_TRUE(run.times.hold_ms) << what << ": never held";
+      EXPECT_LE(*run.times.hold_ms, hold_bound_ms) << run.times.hold_reason;
+      ExpectOperatorRecovery(stack, run, "resume", 1.0, what);
+      const CounterDelta d = Counters(stack.bus, run.fault_us, WallUs());
+      PrintCounters(what, d);
+      EXPECT_GT(d.Of("safety", "supervisor_faults"), 0) << what;
+      ExpectAllRunning(stack, "", "after " + what);
+      ASSERT_TRUE(stack.WaitArmed(5.0, WallUs() - 1'000'000)) << what << ": not back to normal";
+    }
+  } while (SoakGoesOn(started, &rounds));
+  std::printf("[process-fault] %s: %d round(s); %s\n", name.c_str(), rounds,
+              test::Describe(stack.bus.truth).c_str());
+  test::ExpectWithinLimits(stack.bus.truth);
+  ExpectTheLogHasEverySampleHeard(stack);
+}
+
+TEST(ProcessFaults, EstimatorStoppedAndKilled) {
+  LoopProcessStoppedAndKilled("estimator", kPortEstimator, 5);
+}
+
+TEST(ProcessFaults, ControllerStoppedAndKilled) {
+  LoopProcessStoppedAndKilled("controller", kPortController, 6);
 }
 
 // The safety process dies or stops: no safe command; the actuators' command
