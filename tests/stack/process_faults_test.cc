@@ -575,79 +575,28 @@ void ExpectTheLogHasEverySampleHeard(Stack& stack) {
   EXPECT_EQ(missing, 0) << "the recorder lost sensor samples the test heard";
 }
 
-// The plant dies or stops: no sensor sample, so no state and no command;
-// the supervisor holds when plant_sim's heartbeat is lost
-// (supervisor.heartbeat_timeout_s) or restarts (its sequence starts over).
-TEST(ProcessFaults, PlantSimStoppedAndKilled) {
-  test::LauncherLock lock;
-  PrintSeed();
-  std::mt19937_64 rng(Seed() * 4 + 0);
-  Stack stack("plant_sim", kPortPlantSim, false);
-  stack.Start();
-  ASSERT_TRUE(stack.WaitArmed(10.0)) << "the stack did not arm";
+/// The rounds of faults of a process whose loss the supervisor holds on:
+/// `name` (`*target`) stopped, then killed and `restart`ed, at random
+/// instants (again and again for STEWART_SOAK_S). Each fault is held
+/// (`check_hold(kill, times)` judges how fast), recovered only by the
+/// operator's reset and resume, counted as a supervisor fault, and no other
+/// process dies; at the end every limit held on ground truth and the log
+/// holds every sample heard.
+void HeldFaultRounds(Stack& stack, std::mt19937_64* rng, const std::string& name,
+                     std::unique_ptr<test::ChildProcess>* target,
+                     const std::function<std::unique_ptr<test::ChildProcess>()>& restart,
+                     const std::function<void(bool kill, const SafeTimes&)>& check_hold) {
   const StackConfig& c = stack.config();
-  const double hb_ms = 1e3 * c.supervisor.heartbeat_timeout_s;
-  const auto started = std::chrono::steady_clock::now();
-  int rounds = 0;
-  do {
-    for (const bool kill : {false, true}) {
-      const std::string what = std::string("plant_sim ") + (kill ? "kill" : "stop");
-      const FaultRun run = InjectFault(
-          stack, &rng, "plant_sim", &stack.plant, kill, StopSeconds(c),
-          [&] { return stack.StartPlantSim(); },
-          [](const SafeTimes& t) { return t.hold_ms.has_value(); }, StopSeconds(c) + 2.0);
-      ASSERT_TRUE(run.times.hold_ms) << what << ": never held";
-      if (kill) {
-        // The new plant_sim's first heartbeat: a restart, judged at once.
-        EXPECT_LT(*run.times.hold_ms, hb_ms) << run.times.hold_reason;
-      } else {
-        EXPECT_LE(*run.times.hold_ms, hb_ms + 1e3 / c.lcm.health_rate_hz + 150.0);
-        EXPECT_GE(*run.times.hold_ms, hb_ms - 1e3 / c.lcm.health_rate_hz - 10.0);
-      }
-      ExpectOperatorRecovery(stack, run, "resume", 1.0, what);
-      const CounterDelta d = Counters(stack.bus, run.fault_us, WallUs());
-      PrintCounters(what, d);
-      EXPECT_GT(d.Of("safety", "supervisor_faults"), 0) << what;
-      ExpectAllRunning(stack, "", "after " + what);
-      ASSERT_TRUE(stack.WaitArmed(5.0, WallUs() - 1'000'000)) << what << ": not back to normal";
-    }
-  } while (SoakGoesOn(started, &rounds));
-  std::printf("[process-fault] plant_sim: %d round(s); %s\n", rounds,
-              test::Describe(stack.bus.truth).c_str());
-  test::ExpectWithinLimits(stack.bus.truth);
-  ExpectTheLogHasEverySampleHeard(stack);
-}
-
-/// A process between the plant and the filter stopped and killed: the
-/// estimator (no state: no safe command, the actuators' command timeout; a
-/// restarted one starts over and is judged a restart, or its first
-/// estimates are not usable) or the controller (no nominal: the safety
-/// process's watchdog; a restarted one is judged a restart). Either way the
-/// supervisor holds within the heartbeat timeout, and after the operator's
-/// reset and resume the platform moves on.
-void LoopProcessStoppedAndKilled(const std::string& name, int port, uint64_t seed_stream) {
-  test::LauncherLock lock;
-  PrintSeed();
-  std::mt19937_64 rng(Seed() * 4 + seed_stream);
-  Stack stack(name, port, false);
-  stack.Start();
-  ASSERT_TRUE(stack.WaitArmed(10.0)) << "the stack did not arm";
-  const StackConfig& c = stack.config();
-  const bool estimator = name == "estimator";
-  std::unique_ptr<test::ChildProcess>* target = estimator ? &stack.estimator : &stack.controller;
-  const double hold_bound_ms =
-      1e3 * c.supervisor.heartbeat_timeout_s + 1e3 / c.lcm.health_rate_hz + 150.0;
   const auto started = std::chrono::steady_clock::now();
   int rounds = 0;
   do {
     for (const bool kill : {false, true}) {
       const std::string what = name + (kill ? " kill" : " stop");
       const FaultRun run = InjectFault(
-          stack, &rng, name, target, kill, StopSeconds(c),
-          [&] { return estimator ? stack.StartEstimator() : stack.StartController(); },
+          stack, rng, name, target, kill, StopSeconds(c), restart,
           [](const SafeTimes& t) { return t.hold_ms.has_value(); }, StopSeconds(c) + 2.0);
       ASSERT_TRUE(run.times.hold_ms) << what << ": never held";
-      EXPECT_LE(*run.times.hold_ms, hold_bound_ms) << run.times.hold_reason;
+      check_hold(kill, run.times);
       ExpectOperatorRecovery(stack, run, "resume", 1.0, what);
       const CounterDelta d = Counters(stack.bus, run.fault_us, WallUs());
       PrintCounters(what, d);
@@ -662,12 +611,77 @@ void LoopProcessStoppedAndKilled(const std::string& name, int port, uint64_t see
   ExpectTheLogHasEverySampleHeard(stack);
 }
 
+// The plant dies or stops: no sensor sample, so no state and no command;
+// the supervisor holds when plant_sim's heartbeat is lost
+// (supervisor.heartbeat_timeout_s) or restarts (its sequence starts over).
+TEST(ProcessFaults, PlantSimStoppedAndKilled) {
+  test::LauncherLock lock;
+  PrintSeed();
+  std::mt19937_64 rng(Seed() * 4 + 0);
+  Stack stack("plant_sim", kPortPlantSim, false);
+  stack.Start();
+  ASSERT_TRUE(stack.WaitArmed(10.0)) << "the stack did not arm";
+  const StackConfig& c = stack.config();
+  const double hb_ms = 1e3 * c.supervisor.heartbeat_timeout_s;
+  HeldFaultRounds(
+      stack, &rng, "plant_sim", &stack.plant, [&] { return stack.StartPlantSim(); },
+      [&](bool kill, const SafeTimes& t) {
+        if (kill) {
+          // The new plant_sim's first heartbeat: a restart, judged at once.
+          EXPECT_LT(*t.hold_ms, hb_ms) << t.hold_reason;
+        } else {
+          EXPECT_LE(*t.hold_ms, hb_ms + 1e3 / c.lcm.health_rate_hz + 150.0);
+          EXPECT_GE(*t.hold_ms, hb_ms - 1e3 / c.lcm.health_rate_hz - 10.0);
+        }
+      });
+}
+
+/// One process stopped and killed whose loss the supervisor holds on: the
+/// estimator (no state: no safe command, the actuators' command timeout; a
+/// restarted one starts over and is judged a restart, or its first
+/// estimates are not usable), the controller (no nominal: the safety
+/// process's watchdog; a restarted one is judged a restart), and in
+/// hardware mode hw_emulator (the device: hw_bridge's link times out and it
+/// reports FAULT) or hw_bridge (no sensor_t at all; its heartbeat stops, or
+/// restarts; the device's watchdog cuts the drive). Either way the
+/// supervisor holds within the detection time, and after the operator's
+/// reset and resume the platform moves on.
+void OneProcessStoppedAndKilled(const std::string& name, int port, uint64_t seed_stream) {
+  test::LauncherLock lock;
+  PrintSeed();
+  std::mt19937_64 rng(Seed() * 4 + seed_stream);
+  const bool hardware = name == "hw_bridge" || name == "hw_emulator";
+  Stack stack(name, port, hardware);
+  stack.Start();
+  ASSERT_TRUE(stack.WaitArmed(hardware ? 15.0 : 10.0)) << "the stack did not arm";
+  const StackConfig& c = stack.config();
+  const std::map<std::string, std::unique_ptr<test::ChildProcess>*> targets = {
+      {"estimator", &stack.estimator},
+      {"controller", &stack.controller},
+      {"hw_bridge", &stack.bridge},
+      {"hw_emulator", &stack.emulator}};
+  // What tells the supervisor (a heartbeat lost, or for the device the
+  // bridge's link timeout and its FAULT heartbeat), a heartbeat period, and
+  // slack for a loaded host.
+  const double detect_s =
+      name == "hw_emulator" ? c.hw_bridge.link_timeout_s : c.supervisor.heartbeat_timeout_s;
+  const double hold_bound_ms = 1e3 * detect_s + 1e3 / c.lcm.health_rate_hz + 150.0;
+  HeldFaultRounds(
+      stack, &rng, name, targets.at(name),
+      [&]() -> std::unique_ptr<test::ChildProcess> {
+        if (name == "estimator") return stack.StartEstimator();
+        if (name == "controller") return stack.StartController();
+        return name == "hw_bridge" ? stack.StartBridge() : stack.StartEmulator();
+      },
+      [&](bool, const SafeTimes& t) { EXPECT_LE(*t.hold_ms, hold_bound_ms) << t.hold_reason; });
+}
+
 TEST(ProcessFaults, EstimatorStoppedAndKilled) {
-  LoopProcessStoppedAndKilled("estimator", kPortEstimator, 5);
+  OneProcessStoppedAndKilled("estimator", kPortEstimator, 5);
 }
 
 TEST(ProcessFaults, ControllerStoppedAndKilled) {
-  LoopProcessStoppedAndKilled("controller", kPortController, 6);
+  OneProcessStoppedAndKilled("controller", kPortController, 6);
 }
 
 // The safety process dies or stops: no safe command; the actuators' command
@@ -717,60 +731,15 @@ TEST(ProcessFaults, SafetyStoppedAndKilled) {
 // goes down (hw_bridge.link_timeout_s: a FAULT heartbeat) and the stack has
 // no state; the device's own watchdog zeroes the drive. A restarted device
 // follows the bridge's link session again (docs/wire-protocol.md).
-/// The device side (hardware mode) stopped and killed: `name` is hw_emulator
-/// (the device: hw_bridge's link times out and it reports FAULT) or
-/// hw_bridge (no sensor_t at all; its heartbeat stops, or restarts). Either
-/// way no sample reaches the stack: HOLD, the device's watchdog cuts the
-/// drive, and after the operator's reset and resume the platform moves on.
-void DeviceSideStoppedAndKilled(const std::string& name, int port, uint64_t seed_stream) {
-  test::LauncherLock lock;
-  PrintSeed();
-  std::mt19937_64 rng(Seed() * 4 + seed_stream);
-  Stack stack(name, port, true);
-  stack.Start();
-  ASSERT_TRUE(stack.WaitArmed(15.0)) << "the stack did not arm";
-  const StackConfig& c = stack.config();
-  const bool bridge = name == "hw_bridge";
-  std::unique_ptr<test::ChildProcess>* target = bridge ? &stack.bridge : &stack.emulator;
-  // What tells the supervisor (the bridge's link timeout and its FAULT
-  // heartbeat, or the bridge's own heartbeat lost), a heartbeat period, and
-  // slack for a loaded host.
-  const double detect_s = bridge ? c.supervisor.heartbeat_timeout_s : c.hw_bridge.link_timeout_s;
-  const double hold_bound_ms = 1e3 * detect_s + 1e3 / c.lcm.health_rate_hz + 150.0;
-  const auto started = std::chrono::steady_clock::now();
-  int rounds = 0;
-  do {
-    for (const bool kill : {false, true}) {
-      const std::string what = name + (kill ? " kill" : " stop");
-      const FaultRun run = InjectFault(
-          stack, &rng, name, target, kill, StopSeconds(c),
-          [&] { return bridge ? stack.StartBridge() : stack.StartEmulator(); },
-          [](const SafeTimes& t) { return t.hold_ms.has_value(); }, StopSeconds(c) + 2.0);
-      ASSERT_TRUE(run.times.hold_ms) << what << ": never held";
-      EXPECT_LE(*run.times.hold_ms, hold_bound_ms) << run.times.hold_reason;
-      ExpectOperatorRecovery(stack, run, "resume", 1.0, what);
-      const CounterDelta d = Counters(stack.bus, run.fault_us, WallUs());
-      PrintCounters(what, d);
-      EXPECT_GT(d.Of("safety", "supervisor_faults"), 0) << what;
-      ExpectAllRunning(stack, "", "after " + what);
-      ASSERT_TRUE(stack.WaitArmed(5.0, WallUs() - 1'000'000)) << what << ": not back to normal";
-    }
-  } while (SoakGoesOn(started, &rounds));
-  std::printf("[process-fault] %s: %d round(s); %s\n", name.c_str(), rounds,
-              test::Describe(stack.bus.truth).c_str());
-  test::ExpectWithinLimits(stack.bus.truth);
-  ExpectTheLogHasEverySampleHeard(stack);
-}
-
 TEST(ProcessFaults, HwEmulatorStoppedAndKilled) {
-  DeviceSideStoppedAndKilled("hw_emulator", kPortHwEmulator, 3);
+  OneProcessStoppedAndKilled("hw_emulator", kPortHwEmulator, 3);
 }
 
 // The bridge stopped: it holds a backlog of the device's frames and of safe
 // commands when it is continued; killed, a new bridge starts a new link
 // session the device follows (docs/wire-protocol.md, "Sessions").
 TEST(ProcessFaults, HwBridgeStoppedAndKilled) {
-  DeviceSideStoppedAndKilled("hw_bridge", kPortHwBridge, 0x5bd1e995);
+  OneProcessStoppedAndKilled("hw_bridge", kPortHwBridge, 0x5bd1e995);
 }
 
 /// stewart_log_export --check on `log`: its output (the check's lines) and
