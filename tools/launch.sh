@@ -205,14 +205,31 @@ check_network() {
     [[ -f $tmp/$r.out ]] || continue
     if [[ -s $tmp/$r.err ]]; then echo "  $r: $(head -n 1 "$tmp/$r.err")"; ok=0; continue; fi
     for s in "${hosts[@]}"; do
-      sent=$(awk '$1 == "sent" { print $2 }' "$tmp/$s.out" 2>/dev/null)
-      heard=$(awk -v s="$s" '$1 == "heard" && $2 == s { print $3 }' "$tmp/$r.out")
-      echo "  $r hears $s: ${heard:-0} of ${sent:-?} probes"
+      # A host without a route sent nothing: no file (and no exit under set -e).
+      sent=$(awk '$1 == "sent" { print $2 }' "$tmp/$s.out" 2>/dev/null || true)
+      heard=$(awk -v s="$s" '$1 == "heard" && $2 == s { print $3 }' "$tmp/$r.out" || true)
+      if [[ -z $sent ]]; then echo "  $r hears $s: $s sent no probes"; ok=0; continue; fi
+      echo "  $r hears $s: ${heard:-0} of $sent probes"
       if [[ -z $heard ]]; then ok=0; fi
     done
   done
-  if ((!ok)) && command -v iptables >/dev/null && iptables -S 2>/dev/null | grep -qE -- '-P INPUT DROP|-j (DROP|REJECT)'; then
-    echo "  a firewall rule drops packets here (iptables -S): allow UDP to the URL's port and IGMP"
+  # A host that hears less than all may have a packet filter: name the
+  # rules that drop or reject (iptables, either backend; nft's own tables).
+  if ((!ok)); then
+    for h in "${hosts[@]}"; do
+      prefix=()
+      [[ $h == here ]] || read -ra prefix <<<"${HOST_PREFIX[$h]}"
+      local rules=""
+      if command -v iptables >/dev/null; then
+        rules=$("${prefix[@]}" iptables -S 2>/dev/null | grep -E -- '-P (INPUT|OUTPUT) DROP|-j (DROP|REJECT)' || true)
+      fi
+      if [[ -z $rules ]] && command -v nft >/dev/null; then
+        rules=$("${prefix[@]}" nft list ruleset 2>/dev/null | grep -E '(^|[[:space:]])(drop|reject)([[:space:]]|;|$)' || true)
+      fi
+      [[ -n $rules ]] || continue
+      echo "  $h: a firewall rule drops packets (iptables -S / nft list ruleset): allow UDP to the URL's port and IGMP"
+      sed 's/^/      /' <<<"$rules" | head -n 5
+    done
   fi
   rm -rf "$tmp"
   if ((ok)); then echo "network check: every host hears every host"; return 0; fi

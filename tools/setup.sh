@@ -16,7 +16,7 @@ PACKAGES=(
   python3-matplotlib python3-numpy python3-pandas python3-pil python3-yaml
   xvfb xauth x11-utils imagemagick
   libssl-dev
-  iproute2 procps
+  iproute2 procps iptables
   parallel
   # stewart_viewer: the web server, three.js for the page, and the browser
   # its test drives (docs/operations.md, "The viewer").

@@ -123,6 +123,35 @@ TEST_F(HostsLab, NetworkCheckNamesAPartition) {
   EXPECT_EQ(out.find("device hears observer: 0 of"), std::string::npos) << out;
 }
 
+TEST_F(HostsLab, NetworkCheckNamesAHostWithoutAMulticastRoute) {
+  ASSERT_EQ(test::Shell("ip -n stt-control route del 224.0.0.0/4"), 0);
+  const test::LaunchResult check = Launch("--check-network", LabUrl(8012), "check_route");
+  const std::string out = test::ReadFile(check.output_path);
+  EXPECT_NE(check.exit_code, 0) << out;
+  EXPECT_NE(out.find("control: no route for 239.255.78.1"), std::string::npos) << out;
+  EXPECT_NE(out.find("ip route add 224.0.0.0/4 dev IFACE"), std::string::npos) << out;
+  // The hosts that have their route are checked still, and hear each other.
+  EXPECT_NE(out.find("device hears observer: "), std::string::npos) << out;
+  EXPECT_EQ(out.find("device hears observer: 0 of"), std::string::npos) << out;
+  EXPECT_NE(out.find("device hears control: control sent no probes"), std::string::npos) << out;
+}
+
+TEST_F(HostsLab, NetworkCheckNamesAFirewallRuleOnTheHostThatHasIt) {
+  if (test::Shell("command -v iptables >/dev/null") != 0) {
+    GTEST_SKIP() << "iptables is not installed (tools/setup.sh installs it); not run";
+  }
+  ASSERT_EQ(test::Shell("ip netns exec stt-control iptables -A INPUT -p udp -j DROP"), 0);
+  const test::LaunchResult check = Launch("--check-network", LabUrl(8012), "check_firewall");
+  const std::string out = test::ReadFile(check.output_path);
+  EXPECT_NE(check.exit_code, 0) << out;
+  EXPECT_NE(out.find("control hears device: 0 of"), std::string::npos) << out;
+  EXPECT_NE(out.find("control: a firewall rule drops packets"), std::string::npos) << out;
+  EXPECT_NE(out.find("-A INPUT -p udp -j DROP"), std::string::npos) << out;
+  // Only the host with the rule is named.
+  EXPECT_EQ(out.find("device: a firewall rule"), std::string::npos) << out;
+  EXPECT_EQ(out.find("observer: a firewall rule"), std::string::npos) << out;
+}
+
 TEST_F(HostsLab, PaperScenarioAcrossThreeHosts) {
   constexpr double kDurationS = 12.0;
   const test::LaunchResult run =
