@@ -165,6 +165,13 @@ TEST_F(HostsLab, PaperScenarioAcrossThreeHosts) {
   const test::RecordedRun recorded = test::ReadRecordedRun(folder + "/log.lcm", config);
   ASSERT_NE(recorded.Worst(), nullptr) << "nothing recorded on the observer";
   std::printf("[hosts] %s\n", test::Describe(recorded).c_str());
+  // The loop's latency across the bridge, as the plant measured it
+  // (docs/performance.md, "Latency across hosts").
+  const std::string plant_log = test::ReadFile(folder + "/plant_sim.log");
+  const size_t latency = plant_log.find("sample-to-command latency");
+  ASSERT_NE(latency, std::string::npos) << "plant_sim.log has no latency line";
+  std::printf("[hosts] plant_sim: %s\n",
+              plant_log.substr(latency, plant_log.find('\n', latency) - latency).c_str());
   EXPECT_GE(static_cast<double>(recorded.truth_samples),
             0.95 * kDurationS * config.sensors.rate_hz);
   test::ExpectWithinLimits(recorded);
