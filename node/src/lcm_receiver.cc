@@ -210,6 +210,9 @@ int LcmReceiver::HandleTimeout(int timeout_ms) {
 }
 
 int LcmReceiver::HandleTimeoutUs(int64_t timeout_us) {
+  // A message whose fragments stopped coming is counted when it is given
+  // up, not when the next fragment happens to arrive (which may be never).
+  if (!reassemblies_.empty()) DropStaleReassemblies(ReceiveClockUs());
   pollfd p{fd_, POLLIN, 0};
   timespec timeout{};
   if (timeout_us > 0) {
@@ -301,13 +304,7 @@ int LcmReceiver::HandleDatagram(const uint8_t* data, int size, uint32_t sender_i
     return 0;
   }
   // Messages whose fragments stopped coming are given up first.
-  for (size_t i = 0; i < reassemblies_.size();) {
-    if (recv_utime - reassemblies_[i]->first_recv_utime > kMaxReassemblyAgeUs) {
-      DropReassembly(i);
-    } else {
-      ++i;
-    }
-  }
+  DropStaleReassemblies(recv_utime);
   size_t index = reassemblies_.size();
   for (size_t i = 0; i < reassemblies_.size(); ++i) {
     const Reassembly& candidate = *reassemblies_[i];
@@ -357,6 +354,16 @@ int LcmReceiver::HandleDatagram(const uint8_t* data, int size, uint32_t sender_i
   reassemblies_.erase(reassemblies_.begin() + static_cast<std::ptrdiff_t>(index));
   reassembly_bytes_ -= done->size;
   return Deliver(done->channel.c_str(), done->data.get(), msg_size, recv_utime);
+}
+
+void LcmReceiver::DropStaleReassemblies(int64_t now_us) {
+  for (size_t i = 0; i < reassemblies_.size();) {
+    if (now_us - reassemblies_[i]->first_recv_utime > kMaxReassemblyAgeUs) {
+      DropReassembly(i);
+    } else {
+      ++i;
+    }
+  }
 }
 
 void LcmReceiver::DropReassembly(size_t index) {

@@ -5,6 +5,7 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <stdexcept>
@@ -50,6 +51,26 @@ std::vector<uint8_t> LcmFragmentDatagram(uint32_t seqno, uint32_t msg_size,
   }
   d.insert(d.end(), data.begin(), data.end());
   return d;
+}
+
+std::vector<std::vector<uint8_t>> LcmFragmentedMessage(uint32_t seqno, const std::string& channel,
+                                                       const std::vector<uint8_t>& payload,
+                                                       size_t max_data_bytes) {
+  if (max_data_bytes == 0) throw std::invalid_argument("fragments of 0 bytes");
+  const size_t count = std::max<size_t>(1, (payload.size() + max_data_bytes - 1) / max_data_bytes);
+  if (count > 65535) throw std::invalid_argument("more than 65535 fragments");
+  std::vector<std::vector<uint8_t>> datagrams;
+  datagrams.reserve(count);
+  for (size_t i = 0; i < count; ++i) {
+    const size_t begin = i * max_data_bytes;
+    const size_t end = std::min(payload.size(), begin + max_data_bytes);
+    datagrams.push_back(LcmFragmentDatagram(
+        seqno, static_cast<uint32_t>(payload.size()), static_cast<uint32_t>(begin),
+        static_cast<uint16_t>(i), static_cast<uint16_t>(count), channel,
+        std::vector<uint8_t>(payload.begin() + static_cast<std::ptrdiff_t>(begin),
+                             payload.begin() + static_cast<std::ptrdiff_t>(end))));
+  }
+  return datagrams;
 }
 
 RawBusSender::RawBusSender(const std::string& url) : to_(sizeof(sockaddr_in)) {

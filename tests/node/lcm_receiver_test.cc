@@ -210,6 +210,67 @@ TEST(LcmReceiver, ReceivesShortAndFragmentedMessagesFromLcmAndOnlyItsChannels) {
   EXPECT_EQ(receiver.counters().decode_failures, 0);
 }
 
+// A small message split into fragments (LCM itself sends it whole): the
+// receiver reassembles it and hands over exactly the message, so a process
+// judges a fragmented message as it judges a short one (stewart_inject
+// --fragment-bytes sends the bus faults both ways).
+TEST(LcmReceiver, ReassemblesASmallMessageSentInFragments) {
+  const std::string url = PrivateLcmUrl(7805);
+  LcmReceiver receiver(url);
+  Sink sink;
+  receiver.Subscribe("CMD", &Sink::OnCommand, &sink);
+  RawBusSender bus(url);
+  force_command_t command{};
+  command.seq = 7;
+  command.utime = 123456789;
+  std::vector<uint8_t> payload(static_cast<size_t>(command.getEncodedSize()));
+  ASSERT_GE(command.encode(payload.data(), 0, static_cast<int>(payload.size())), 0);
+  const auto fragments = LcmFragmentedMessage(77, "CMD", payload, 16);
+  ASSERT_EQ(fragments.size(), (payload.size() + 15) / 16);
+  ASSERT_GE(fragments.size(), 3u);
+  for (const auto& d : fragments) ASSERT_TRUE(bus.Send(d));
+  PumpUntil(&receiver, [&] { return !sink.seqs.empty(); });
+  ASSERT_EQ(sink.seqs.size(), 1u);
+  EXPECT_EQ(sink.seqs[0], 7);
+  EXPECT_EQ(receiver.counters().messages, 1);
+  EXPECT_EQ(receiver.counters().datagrams, static_cast<int64_t>(fragments.size()));
+  EXPECT_THROW(LcmFragmentedMessage(1, "CMD", payload, 0), std::invalid_argument);
+
+  // Any size, one fragment short of, at and past a fragment's boundary.
+  std::vector<uint32_t> sizes;
+  LcmReceiver any(url);
+  any.SubscribeAll([&](const lcm::ReceiveBuffer& rbuf, const std::string&) {
+    sizes.push_back(rbuf.data_size);
+  });
+  const std::vector<uint32_t> sent = {1, 63, 64, 65, 128, 511};
+  for (uint32_t size : sent) {
+    for (const auto& d : LcmFragmentedMessage(size, "ANY", std::vector<uint8_t>(size, 0xee), 64))
+      ASSERT_TRUE(bus.Send(d));
+  }
+  PumpUntil(&any, [&] { return sizes.size() == sent.size(); });
+  EXPECT_EQ(sizes, sent);
+  EXPECT_EQ(any.counters().incomplete_fragmented, 0);
+  EXPECT_EQ(any.counters().bad_datagrams, 0);
+}
+
+// A message whose fragments stop coming is given up and counted within the
+// reassembly age (0.5 s), though no fragment follows to notice it.
+TEST(LcmReceiver, CountsAnAbandonedMessageWithoutAnotherFragment) {
+  const std::string url = PrivateLcmUrl(7806);
+  LcmReceiver receiver(url);
+  Sink sink;
+  receiver.Subscribe("CMD", &Sink::OnCommand, &sink);
+  RawBusSender bus(url);
+  const auto fragments = LcmFragmentedMessage(5, "CMD", std::vector<uint8_t>(200, 1), 64);
+  ASSERT_TRUE(bus.Send(fragments[0]));
+  PumpUntil(&receiver, [&] { return receiver.counters().datagrams == 1; });
+  ASSERT_EQ(receiver.counters().datagrams, 1);
+  EXPECT_EQ(receiver.counters().incomplete_fragmented, 0);
+  PumpUntil(&receiver, [&] { return receiver.counters().incomplete_fragmented > 0; }, 2.0);
+  EXPECT_EQ(receiver.counters().incomplete_fragmented, 1);
+  EXPECT_EQ(receiver.counters().datagrams, 1);
+}
+
 int64_t WallUtimeNow() {
   return std::chrono::duration_cast<std::chrono::microseconds>(
              std::chrono::system_clock::now().time_since_epoch())

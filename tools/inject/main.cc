@@ -29,6 +29,11 @@
 //       (single copies, each 10 s off), a sustained second time base, as a
 //       device whose clock jumped would send.
 //
+// --fragment-bytes N (every mode but fragment-flood) sends each message as a
+// fragmented one, N bytes of it per fragment, where LCM sends these small
+// messages whole: what a receiver does with a message must not depend on
+// how it was cut into datagrams.
+//
 // Without --channel: every channel of the config. Sends to the config's URL
 // (--lcm-url) with its TTL. Prints one line: what was sent. Exit 0, 2 on a
 // bad flag.
@@ -95,6 +100,7 @@ struct Options {
   uint32_t declared_bytes = 16u << 20;
   double shift_s = 10.0;
   uint32_t seed = 1;
+  size_t fragment_bytes = 0;  ///< 0: whole messages
 };
 
 constexpr int kFingerprintBytes = 8;
@@ -275,6 +281,24 @@ ExitCode Run(const StackConfig& config, const Options& options) {
       ++failed;
     }
   };
+  if (options.fragment_bytes > 0 && options.mode == Mode::kFragmentFlood) {
+    spdlog::error("stewart_inject: --fragment-bytes is for the modes that send whole messages");
+    return ExitCode::kBadInput;
+  }
+  // One message, whole or in fragments; counted once, sent when the kernel
+  // took every datagram of it.
+  auto send_message = [&](const std::string& channel, const std::vector<uint8_t>& payload) {
+    if (options.fragment_bytes == 0) {
+      send(LcmShortDatagram(seqno++, channel, payload));
+      return;
+    }
+    bool all = true;
+    for (const auto& datagram :
+         LcmFragmentedMessage(seqno++, channel, payload, options.fragment_bytes)) {
+      all = bus.Send(datagram) && all;
+    }
+    ++(all ? sent : failed);
+  };
   const bool from_bus = options.mode != Mode::kFragmentFlood && options.mode != Mode::kGarbage;
   if (!from_bus) {
     for (int64_t i = 0; !StopRequested(); ++i) {
@@ -293,7 +317,7 @@ ExitCode Run(const StackConfig& config, const Options& options) {
         std::uniform_int_distribution<int> length(0, 512);
         std::vector<uint8_t> payload(static_cast<size_t>(length(rng)));
         for (uint8_t& b : payload) b = static_cast<uint8_t>(rng());
-        send(LcmShortDatagram(seqno++, channel, payload));
+        send_message(channel, payload);
       }
     }
   } else {
@@ -317,12 +341,14 @@ ExitCode Run(const StackConfig& config, const Options& options) {
               : Mutate(options.mode, data, rbuf.data_size, options.shift_s, &rng);
       if (payload.empty() && options.mode != Mode::kTruncate) return;
       own.Add(payload);
-      send(LcmShortDatagram(seqno++, channel, payload));
+      send_message(channel, payload);
     });
     while (!StopRequested() && std::chrono::steady_clock::now() < end) receiver.HandleTimeout(10);
   }
-  std::printf("stewart_inject: %lld datagrams sent (%lld refused by the kernel) on %zu channels\n",
-              static_cast<long long>(sent), static_cast<long long>(failed), channels.size());
+  std::printf("stewart_inject: %lld %s sent (%lld refused by the kernel) on %zu channels\n",
+              static_cast<long long>(sent),
+              options.fragment_bytes > 0 ? "fragmented messages" : "datagrams",
+              static_cast<long long>(failed), channels.size());
   std::fflush(stdout);
   return ExitCode::kOk;
 }
@@ -353,6 +379,9 @@ int main(int argc, char** argv) {
                        "stale/future: how far utime moves; clock-jump: the jump (negative: back)")
             ->check(CLI::Range(-1e9, 1e9));
         app.add_option("--seed", options->seed, "random seed (garbage, truncate)");
+        app.add_option("--fragment-bytes", options->fragment_bytes,
+                       "send each message in fragments of this many bytes (0: whole)")
+            ->check(CLI::Range(0, 65000));
       },
       nullptr, [options](const StackConfig& config, lcm::LCM*) { return Run(config, *options); });
 }

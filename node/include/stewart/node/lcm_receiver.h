@@ -124,6 +124,9 @@ class LcmReceiver {
                      int64_t recv_utime);
   int Deliver(const char* channel, const uint8_t* data, uint32_t size, int64_t recv_utime);
   void DropReassembly(size_t index);  // counted as incomplete
+  /// Gives up (and counts) the messages whose first fragment came more than
+  /// the reassembly age before `now_us`.
+  void DropStaleReassemblies(int64_t now_us);
   bool Subscribed(const std::string& channel) const;
 
   int fd_ = -1;

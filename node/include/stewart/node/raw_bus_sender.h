@@ -24,6 +24,15 @@ std::vector<uint8_t> LcmFragmentDatagram(uint32_t seqno, uint32_t msg_size,
                                          uint16_t fragments_in_msg, const std::string& channel,
                                          const std::vector<uint8_t>& data);
 
+/// `payload` on `channel` as a fragmented message, as LCM sends a large one:
+/// fragments of at most `max_data_bytes` of the message each (>= 1), in
+/// order. A message LCM itself would send whole, split all the same: a
+/// receiver must treat both forms alike. At most 65535 fragments
+/// (std::invalid_argument beyond).
+std::vector<std::vector<uint8_t>> LcmFragmentedMessage(uint32_t seqno, const std::string& channel,
+                                                       const std::vector<uint8_t>& payload,
+                                                       size_t max_data_bytes);
+
 /// Sends datagrams to the multicast group and port of a udpm:// URL, with
 /// TTL 0 unless the URL asks for more (never beyond what the URL allows).
 class RawBusSender {
