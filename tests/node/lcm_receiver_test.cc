@@ -239,9 +239,8 @@ TEST(LcmReceiver, ReassemblesASmallMessageSentInFragments) {
   // Any size, one fragment short of, at and past a fragment's boundary.
   std::vector<uint32_t> sizes;
   LcmReceiver any(url);
-  any.SubscribeAll([&](const lcm::ReceiveBuffer& rbuf, const std::string&) {
-    sizes.push_back(rbuf.data_size);
-  });
+  any.SubscribeAll(
+      [&](const lcm::ReceiveBuffer& rbuf, const std::string&) { sizes.push_back(rbuf.data_size); });
   const std::vector<uint32_t> sent = {1, 63, 64, 65, 128, 511};
   for (uint32_t size : sent) {
     for (const auto& d : LcmFragmentedMessage(size, "ANY", std::vector<uint8_t>(size, 0xee), 64))
@@ -266,7 +265,8 @@ TEST(LcmReceiver, CountsAnAbandonedMessageWithoutAnotherFragment) {
   PumpUntil(&receiver, [&] { return receiver.counters().datagrams == 1; });
   ASSERT_EQ(receiver.counters().datagrams, 1);
   EXPECT_EQ(receiver.counters().incomplete_fragmented, 0);
-  PumpUntil(&receiver, [&] { return receiver.counters().incomplete_fragmented > 0; }, 2.0);
+  PumpUntil(
+      &receiver, [&] { return receiver.counters().incomplete_fragmented > 0; }, 2.0);
   EXPECT_EQ(receiver.counters().incomplete_fragmented, 1);
   EXPECT_EQ(receiver.counters().datagrams, 1);
 }

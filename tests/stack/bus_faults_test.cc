@@ -246,9 +246,9 @@ TEST(BusFaults, HostileTrafficOnEveryChannelIsCountedAndChangesNothingUnsafe) {
   constexpr double kDurationS = 36.0;
   // The plant is not the model (heavier, a payload, joint errors, friction,
   // gains, a push: test::WriteMismatchedTruth).
-  test::ChildProcess plant(with({PLANT_SIM_PATH, "--mode", "realtime", "--duration",
-                                 std::to_string(kDurationS), "--truth",
-                                 test::WriteMismatchedTruth(folder)}));
+  test::ChildProcess plant(
+      with({PLANT_SIM_PATH, "--mode", "realtime", "--duration", std::to_string(kDurationS),
+            "--truth", test::WriteMismatchedTruth(folder)}));
   ASSERT_TRUE(plant.started());
   ASSERT_TRUE(pump_until(
       [&] {
@@ -270,8 +270,8 @@ TEST(BusFaults, HostileTrafficOnEveryChannelIsCountedAndChangesNothingUnsafe) {
     std::vector<std::string> extra;
   };
   const std::vector<std::string> nan_channels = {
-      "--channel", ch.sensors,         "--channel", ch.state_estimate, "--channel",
-      ch.setpoint, "--channel",        ch.command_nominal, "--channel",       ch.command_safe};
+      "--channel", ch.sensors,  "--channel",        ch.state_estimate, "--channel",
+      ch.setpoint, "--channel", ch.command_nominal, "--channel",       ch.command_safe};
   const auto with_channels = [&](std::vector<std::string> extra) {
     extra.insert(extra.end(), nan_channels.begin(), nan_channels.end());
     return extra;
@@ -516,9 +516,9 @@ TEST(BusFaults, HostileTrafficOnEveryChannelIsCountedAndChangesNothingUnsafe) {
   for (size_t i = 0; i < bus.supervisor.size(); ++i) {
     if (bus.supervisor[i].state == supervisor_state_t::STATE_HOLD &&
         bus.supervisor_heard_at[i] >= jump_forward_start) {
-      jump_to_hold_ms = std::chrono::duration<double, std::milli>(bus.supervisor_heard_at[i] -
-                                                                   jump_forward_start)
-                            .count();
+      jump_to_hold_ms =
+          std::chrono::duration<double, std::milli>(bus.supervisor_heard_at[i] - jump_forward_start)
+              .count();
       break;
     }
   }
