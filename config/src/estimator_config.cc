@@ -19,6 +19,9 @@ EstimatorConfig ParseEstimatorConfig(const ConfigNode& estimator) {
   e.initial_velocity_std_mps = estimator.PositiveDouble("initial_velocity_std_mps");
   e.initial_angular_rate_std_radps = estimator.PositiveDouble("initial_angular_rate_std_radps");
   e.initial_gyro_bias_std_radps = estimator.PositiveDouble("initial_gyro_bias_std_radps");
+  e.initial_accel_bias_std_mps2 = estimator.NonNegativeDouble("initial_accel_bias_std_mps2");
+  e.accel_bias_walk_mps2_per_sqrt_s =
+      estimator.NonNegativeDouble("accel_bias_walk_mps2_per_sqrt_s");
   e.leg_noise_inflation = estimator.PositiveDouble("leg_noise_inflation");
   e.use_accelerometer = estimator.Bool("use_accelerometer");
   e.gating_chi2 = estimator.PositiveDouble("gating_chi2");

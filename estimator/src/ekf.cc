@@ -96,13 +96,13 @@ EulerAngleTrig ShiftEulerAngleTrig(const EulerAngleTrig& from, const Vector3d& d
 }
 
 // P -= G G^T on the lower block triangle (blocks of rows and columns [0, 6),
-// [6, 12), [12, 18), [18, 22): whole SIMD packets), the upper blocks as the
+// [6, 12), [12, 18), [18, 24): whole SIMD packets), the upper blocks as the
 // mirror. Inside a diagonal block an entry and its mirror are the same sum of
 // the same products in the same order, so P stays symmetric to the last bit.
 template <int Start, int End, int M>
-void SubtractGramBlock(const Eigen::Matrix<double, kEkfStateSize + 1, M>& g,
-                       Eigen::Matrix<double, kEkfStateSize + 1, kEkfStateSize + 1>* p) {
-  constexpr int kRows = kEkfStateSize + 1 - Start;
+void SubtractGramBlock(const Eigen::Matrix<double, kEkfPaddedSize, M>& g,
+                       Eigen::Matrix<double, kEkfPaddedSize, kEkfPaddedSize>* p) {
+  constexpr int kRows = kEkfPaddedSize - Start;
   for (int j = Start; j < End; ++j) {
     Eigen::Matrix<double, kRows, 1> col = p->col(j).template tail<kRows>();
     for (int k = 0; k < M; ++k) col -= g(j, k) * g.col(k).template tail<kRows>();
@@ -111,17 +111,19 @@ void SubtractGramBlock(const Eigen::Matrix<double, kEkfStateSize + 1, M>& g,
 }
 
 template <int M>
-void SubtractGram(const Eigen::Matrix<double, kEkfStateSize + 1, M>& g,
-                  Eigen::Matrix<double, kEkfStateSize + 1, kEkfStateSize + 1>* p) {
-  static_assert(kEkfQd == 6 && kEkfDisturbance == 12 && kEkfGyroBias == 18,
+void SubtractGram(const Eigen::Matrix<double, kEkfPaddedSize, M>& g,
+                  Eigen::Matrix<double, kEkfPaddedSize, kEkfPaddedSize>* p) {
+  static_assert(kEkfQd == 6 && kEkfDisturbance == 12 && kEkfGyroBias == 18 && kEkfAccelBias == 21 &&
+                    kEkfPaddedSize == 24,
                 "the blocks below follow the state layout");
+  constexpr int kN = kEkfPaddedSize;
   SubtractGramBlock<0, 6>(g, p);
   SubtractGramBlock<6, 12>(g, p);
   SubtractGramBlock<12, 18>(g, p);
   SubtractGramBlock<18, kEkfStateSize>(g, p);
-  p->template block<6, 16>(0, 6) = p->template block<16, 6>(6, 0).transpose();
-  p->template block<6, 10>(6, 12) = p->template block<10, 6>(12, 6).transpose();
-  p->template block<6, 4>(12, 18) = p->template block<4, 6>(18, 12).transpose();
+  p->template block<6, kN - 6>(0, 6) = p->template block<kN - 6, 6>(6, 0).transpose();
+  p->template block<6, kN - 12>(6, 12) = p->template block<kN - 12, 6>(12, 6).transpose();
+  p->template block<6, kN - 18>(12, 18) = p->template block<kN - 18, 6>(18, 12).transpose();
 }
 
 }  // namespace
@@ -188,10 +190,13 @@ void Ekf::Initialize(int64_t utime, const Vector6d& q, const Vector6d& qd, const
   x_.segment<6>(kEkfQd) = qd;
   x_.segment<6>(kEkfDisturbance).setZero();
   x_.segment<3>(kEkfGyroBias).setZero();
+  x_.segment<3>(kEkfAccelBias).setZero();
   P_.setZero();
   P_.diagonal().head<kEkfStateSize>() = std.cwiseProduct(std);
-  // Without disturbance estimation d is held at zero, with zero covariance.
+  // Without disturbance estimation d is held at zero, with zero covariance;
+  // so is the accelerometer's bias when it is not estimated.
   if (!config_.estimate_disturbance) P_.diagonal().segment<6>(kEkfDisturbance).setZero();
+  if (!EstimatesAccelBias()) P_.diagonal().segment<3>(kEkfAccelBias).setZero();
   qdd_.setZero();
   last_utime_ = utime;
   initialized_ = true;
@@ -233,6 +238,7 @@ bool Ekf::InitializeFromLegs(const SensorSample& sample, uint32_t* events) {
   std.segment<3>(kEkfQd).setConstant(config_.initial_velocity_std_mps);
   std.segment<3>(kEkfQd + 3).setConstant(config_.initial_angular_rate_std_radps);
   std.segment<3>(kEkfGyroBias).setConstant(config_.initial_gyro_bias_std_radps);
+  std.segment<3>(kEkfAccelBias).setConstant(config_.initial_accel_bias_std_mps2);
   std.segment<3>(kEkfDisturbance).setConstant(config_.initial_disturbance_std_n);
   std.segment<3>(kEkfDisturbance + 3).setConstant(config_.initial_disturbance_std_nm);
   // A restart keeps what was learnt of d (a payload does not go away when
@@ -314,7 +320,7 @@ void Ekf::Predict(double dt_s, int64_t utime, const EulerAngleTrig& trig, bool d
   // (A = dqdd/dq, B = dqdd/dqd, M^-1 = dqdd/dd; W = 0 for the
   // constant-velocity model), and the identity on d and the gyro bias, in
   // place: first T = Phi P (rows), then T Phi^T (columns). With
-  // U = W P_[(q,qd,d), :] (6x22):
+  // U = W P_[(q,qd,d), :] (6x24):
   //   T_q = P_q + dt P_v,  T_v = P_v + U                  (rows)
   //   P'_:q = T_:q + dt T_:v                               (columns)
   //   P'_vv = T_vv + T_v,(q,qd,d) W^T,  P'_(d,b)v = P_(d,b)v + U_(d,b)^T
@@ -323,7 +329,7 @@ void Ekf::Predict(double dt_s, int64_t utime, const EulerAngleTrig& trig, bool d
   if (use_dynamics || legs_held) {
     Eigen::Matrix<double, 6, 18> w;
     w << dt_s * dqdd_dq_, dt_s * dqdd_dqd_, dt_s * m_inv_;
-    Eigen::Matrix<double, 6, kEkfStateSize + 1> u;
+    Eigen::Matrix<double, 6, kEkfPaddedSize> u;
     u.noalias() = w.lazyProduct(P_.topRows<18>());
     P_.middleRows<6>(kEkfQ) += dt_s * rows_v;
     P_.middleRows<6>(kEkfQd) += u;
@@ -331,7 +337,8 @@ void Ekf::Predict(double dt_s, int64_t utime, const EulerAngleTrig& trig, bool d
     z.noalias() = P_.block<6, 18>(kEkfQd, 0).lazyProduct(w.transpose());
     P_.leftCols<6>() += dt_s * P_.middleCols<6>(kEkfQd);
     P_.block<6, 6>(kEkfQd, kEkfQd) += z;
-    P_.block<10, 6>(kEkfDisturbance, kEkfQd) += u.rightCols<10>().transpose();
+    constexpr int kFromD = kEkfPaddedSize - kEkfDisturbance;  // d and the biases
+    P_.block<kFromD, 6>(kEkfDisturbance, kEkfQd) += u.rightCols<kFromD>().transpose();
   } else {
     P_.middleRows<6>(kEkfQ) += dt_s * rows_v;
     P_.leftCols<6>() += dt_s * P_.middleCols<6>(kEkfQd);
@@ -346,6 +353,10 @@ void Ekf::Predict(double dt_s, int64_t utime, const EulerAngleTrig& trig, bool d
   }
   const double walk = config_.gyro_bias_walk_radps_per_sqrt_s;
   P_.diagonal().segment<3>(kEkfGyroBias).array() += walk * walk * dt_s;
+  if (EstimatesAccelBias()) {
+    const double walk_a = config_.accel_bias_walk_mps2_per_sqrt_s;
+    P_.diagonal().segment<3>(kEkfAccelBias).array() += walk_a * walk_a * dt_s;
+  }
   if (config_.estimate_disturbance) {
     const double walk_n = config_.disturbance_walk_n_per_sqrt_s;
     const double walk_nm = config_.disturbance_walk_nm_per_sqrt_s;
@@ -359,7 +370,7 @@ bool Ekf::Correct(const Eigen::Matrix<double, M, 1>& y, const std::array<int, NB
                   const Eigen::Matrix<double, M, 3 * NB>& h, const Eigen::Matrix<double, M, M>& R,
                   double* nis) {
   // P H^T and S = H P H^T + R from the non-zero blocks of H only.
-  Eigen::Matrix<double, kEkfStateSize + 1, M> pht;  // last row: zero
+  Eigen::Matrix<double, kEkfPaddedSize, M> pht;  // last row: zero
   pht.noalias() =
       P_.template middleCols<3>(blocks[0]).lazyProduct(h.template leftCols<3>().transpose());
   for (int b = 1; b < NB; ++b) {
@@ -470,6 +481,9 @@ void Ekf::CorrectAccel(const Vector3d& accel_mps2, const EulerAngleTrig& trig, u
   AccelJacobians j;
   PredictAccel(trig, Vector6d(x_.segment<6>(kEkfQd)), qdd_, imu_offset_m_, params_.gravity_mps2,
                &predicted, &j);
+  // The accelerometer reads the specific force plus its bias (d/db_a = I;
+  // held at zero, with no uncertainty, when it is not estimated).
+  predicted += x_.segment<3>(kEkfAccelBias);
   // The predicted qdd is uncertain by the process model's acceleration noise.
   const double sigma =
       qdd_from_dynamics_ ? config_.dynamics_accel_std_mps2 : config_.process_accel_std_mps2;
@@ -491,17 +505,34 @@ void Ekf::CorrectAccel(const Vector3d& accel_mps2, const EulerAngleTrig& trig, u
   double nis = 0.0;
   const Vector3d y = accel_mps2 - predicted;
   if (!(config_.estimate_disturbance && qdd_from_dynamics_)) {
-    Eigen::Matrix<double, 3, 6> h;
-    h << j.d_angles, j.d_rates;
-    if (!Correct<3, 2>(y, {kEkfQ + 3, kEkfQd + 3}, h, R, &nis)) *events |= kGateAccel;
+    bool used = false;
+    if (EstimatesAccelBias()) {
+      Eigen::Matrix<double, 3, 9> h;
+      h << j.d_angles, j.d_rates, Matrix3d::Identity();
+      used = Correct<3, 3>(y, {kEkfQ + 3, kEkfQd + 3, kEkfAccelBias}, h, R, &nis);
+    } else {
+      Eigen::Matrix<double, 3, 6> h;
+      h << j.d_angles, j.d_rates;
+      used = Correct<3, 2>(y, {kEkfQ + 3, kEkfQd + 3}, h, R, &nis);
+    }
+    if (!used) *events |= kGateAccel;
     return;
   }
   // The specific force sees qdd, and qdd sees d through M^-1: the
   // accelerometer is what makes d observable within a few samples.
-  Eigen::Matrix<double, 3, 12> h;
-  h << j.d_angles, j.d_rates, j.d_qdd * m_inv_;
-  const std::array<int, 4> blocks = {kEkfQ + 3, kEkfQd + 3, kEkfDisturbance, kEkfDisturbance + 3};
-  if (Correct<3, 4>(y, blocks, h, R, &nis)) {
+  // (The bias's block only when it is estimated: its zero covariance would
+  // cost the products and change nothing.)
+  Eigen::Matrix<double, 3, 15> h;
+  h << j.d_angles, j.d_rates, j.d_qdd * m_inv_, Matrix3d::Identity();
+  const std::array<int, 5> blocks = {kEkfQ + 3, kEkfQd + 3, kEkfDisturbance, kEkfDisturbance + 3,
+                                     kEkfAccelBias};
+  const auto correct = [&] {
+    return EstimatesAccelBias()
+               ? Correct<3, 5>(y, blocks, h, R, &nis)
+               : Correct<3, 4>(y, {blocks[0], blocks[1], blocks[2], blocks[3]},
+                               Eigen::Matrix<double, 3, 12>(h.leftCols<12>()), R, &nis);
+  };
+  if (correct()) {
     consecutive_accel_gated_ = 0;
     samples_since_accel_disagreed_ = std::min(samples_since_accel_disagreed_ + 1, kNeverDisagreed);
     return;
@@ -528,7 +559,7 @@ void Ekf::CorrectAccel(const Vector3d& accel_mps2, const EulerAngleTrig& trig, u
       P_.diagonal().segment<3>(kEkfDisturbance).cwiseMax(jump_n * jump_n);
   P_.diagonal().segment<3>(kEkfDisturbance + 3) =
       P_.diagonal().segment<3>(kEkfDisturbance + 3).cwiseMax(jump_nm * jump_nm);
-  if (Correct<3, 4>(y, blocks, h, R, &nis)) {
+  if (correct()) {
     *events |= kEventDisturbanceJump;
   } else {
     *events |= kGateAccel;
@@ -648,6 +679,7 @@ Estimate Ekf::estimate() const {
   e.q_std = P_.diagonal().segment<6>(kEkfQ).cwiseMax(0.0).cwiseSqrt();
   e.qd_std = P_.diagonal().segment<6>(kEkfQd).cwiseMax(0.0).cwiseSqrt();
   e.gyro_bias_radps = x_.segment<3>(kEkfGyroBias);
+  e.accel_bias_mps2 = x_.segment<3>(kEkfAccelBias);
   e.disturbance_n = x_.segment<6>(kEkfDisturbance);
   e.disturbance_std_n = P_.diagonal().segment<6>(kEkfDisturbance).cwiseMax(0.0).cwiseSqrt();
   e.initializing = samples_since_init_ < config_.settle_samples;

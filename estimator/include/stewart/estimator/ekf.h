@@ -1,6 +1,7 @@
 #pragma once
 // Extended Kalman filter fusing the leg potentiometers and the IMU into the
-// platform state [q, qd], the model error d and the gyro bias. docs/estimator.md describes the
+// platform state [q, qd], the model error d and the gyro and accelerometer
+// biases. docs/estimator.md describes the
 // model, the tuning and the measured accuracy. No LCM, no heap allocation
 // per update, and time only from the samples' utime.
 #include <array>
@@ -63,6 +64,7 @@ class Ekf {
                const Eigen::Matrix<double, M, 3 * NB>& h, const Eigen::Matrix<double, M, M>& R,
                double* nis);
   bool LegsUsable(const SensorSample& sample, uint32_t* events) const;
+  bool EstimatesAccelBias() const { return config_.initial_accel_bias_std_mps2 > 0.0; }
 
   PlatformParams params_;
   ActuatorConfig actuators_;
@@ -81,9 +83,9 @@ class Ekf {
   bool initialized_ = false;
   int64_t last_utime_ = 0;
   EkfVector x_ = EkfVector::Zero();
-  /// P in a 22x22 matrix whose last row and column are zero: every column is
-  /// a whole number of SIMD packets.
-  using PaddedMatrix = Eigen::Matrix<double, kEkfStateSize + 1, kEkfStateSize + 1>;
+  /// P in a kEkfPaddedSize square matrix whose padding rows and columns are
+  /// zero: every column is a whole number of SIMD packets.
+  using PaddedMatrix = Eigen::Matrix<double, kEkfPaddedSize, kEkfPaddedSize>;
   PaddedMatrix P_ = PaddedIdentity();
   static PaddedMatrix PaddedIdentity();
   Vector6d qdd_ = Vector6d::Zero();

@@ -7,15 +7,20 @@
 
 namespace stewart {
 
-/// EKF state x = [q (6), qd (6), d (6), b_g (3)]: pose (m, rad; Z-Y-X
-/// Euler), its time derivative (m/s, rad/s Euler rates), the model error d
-/// of M qdd + C qd + G = H F + d (N, N m per rad; model/disturbance.h), gyro
-/// bias (rad/s, {P} axes).
-constexpr int kEkfStateSize = 21;
+/// EKF state x = [q (6), qd (6), d (6), b_g (3), b_a (3)]: pose (m, rad;
+/// Z-Y-X Euler), its time derivative (m/s, rad/s Euler rates), the model
+/// error d of M qdd + C qd + G = H F + d (N, N m per rad;
+/// model/disturbance.h), gyro bias (rad/s, {P} axes), accelerometer bias
+/// (m/s^2, {P} axes: added to the specific force it reads).
+constexpr int kEkfStateSize = 24;
 constexpr int kEkfQ = 0;
 constexpr int kEkfQd = 6;
 constexpr int kEkfDisturbance = 12;
 constexpr int kEkfGyroBias = 18;
+constexpr int kEkfAccelBias = 21;
+/// P's storage: the state size rounded up to whole SIMD packets (2 doubles),
+/// the padding rows and columns zero.
+constexpr int kEkfPaddedSize = (kEkfStateSize + 1) / 2 * 2;
 using EkfVector = Eigen::Matrix<double, kEkfStateSize, 1>;
 using EkfMatrix = Eigen::Matrix<double, kEkfStateSize, kEkfStateSize>;
 
@@ -47,6 +52,7 @@ struct Estimate {
   Vector6d q_std = Vector6d::Zero();
   Vector6d qd_std = Vector6d::Zero();
   Vector3d gyro_bias_radps = Vector3d::Zero();
+  Vector3d accel_bias_mps2 = Vector3d::Zero();    ///< b_a, {P} axes
   Vector6d disturbance_n = Vector6d::Zero();      ///< d (N, N m per rad)
   Vector6d disturbance_std_n = Vector6d::Zero();  ///< its one-sigma uncertainty
   bool initializing = false;                      ///< within settle_samples of a (re)initialisation

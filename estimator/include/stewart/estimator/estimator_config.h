@@ -36,6 +36,11 @@ struct EstimatorConfig {
   double initial_velocity_std_mps = 0.05;
   double initial_angular_rate_std_radps = 0.2;
   double initial_gyro_bias_std_radps = 0.01;
+  /// The accelerometer's bias b_a: its one-sigma uncertainty at a (re)start
+  /// (m/s^2; 0: not estimated, held at zero) and its random walk (m/s^2 per
+  /// sqrt(s)).
+  double initial_accel_bias_std_mps2 = 0.0;
+  double accel_bias_walk_mps2_per_sqrt_s = 0.0;
   /// Multiplies the leg-length variance (noise + ADC quantisation); > 1
   /// absorbs the time correlation of the quantisation error.
   double leg_noise_inflation = 1.6;
