@@ -370,7 +370,7 @@ bool Ekf::Correct(const Eigen::Matrix<double, M, 1>& y, const std::array<int, NB
                   const Eigen::Matrix<double, M, 3 * NB>& h, const Eigen::Matrix<double, M, M>& R,
                   double* nis) {
   // P H^T and S = H P H^T + R from the non-zero blocks of H only.
-  Eigen::Matrix<double, kEkfPaddedSize, M> pht;  // last row: zero
+  Eigen::Matrix<double, kEkfPaddedSize, M> pht;  // padding rows (if any): zero
   pht.noalias() =
       P_.template middleCols<3>(blocks[0]).lazyProduct(h.template leftCols<3>().transpose());
   for (int b = 1; b < NB; ++b) {
