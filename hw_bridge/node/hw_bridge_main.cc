@@ -9,6 +9,8 @@
 #include <memory>
 
 #include "bridge_node.h"
+#include "stewart/common/check.h"
+#include "stewart/hw_bridge/bringup.h"
 #include "stewart/hw_bridge/transport.h"
 #include "stewart/node/node_main.h"
 
@@ -16,7 +18,7 @@ int main(int argc, char** argv) {
   std::string transport, serial_device, device_host, local_host;
   int device_port = -1, local_port = -1, serial_baud = 0;
   bool bringup = false;
-  double bringup_margin_m = -1.0, bringup_speed_cap_mps = -1.0;
+  double bringup_margin_m = -1.0, bringup_speed_cap_mps = -1.0, bringup_end_search_m = -1.0;
   stewart::hw::BringupOptions bringup_options;
   return stewart::NodeMain(
       argc, argv, {"hw_bridge", "hw_bridge: the device link behind the plant_sim LCM interface"},
@@ -41,6 +43,11 @@ int main(int argc, char** argv) {
                        "bring-up guard: leg speed cap (m/s; default twice the full-duty speed "
                        "of actuators.motor)")
             ->check(CLI::PositiveNumber);
+        app.add_option("--bringup-end-search", bringup_end_search_m,
+                       "bring-up guard for the pot calibration's stroke-end run: legs may go to "
+                       "their end stops and up to this far beyond the nominal ends (m; the pots' "
+                       "fault margin widened to match); replaces --bringup-margin")
+            ->check(CLI::PositiveNumber);
       },
       [&](stewart::StackConfig& config) -> std::optional<stewart::ExitCode> {
         stewart::HwBridgeConfig& hw = config.hw_bridge;
@@ -58,6 +65,20 @@ int main(int argc, char** argv) {
             config.actuators.motor);
         if (bringup_speed_cap_mps > 0.0)
           bringup_options.guard.speed_cap_mps = bringup_speed_cap_mps;
+        if (bringup_end_search_m > 0.0) {
+          if (!bringup) throw stewart::InputError("--bringup-end-search", "goes with --bringup");
+          if (bringup_margin_m > 0.0) {
+            throw stewart::InputError("--bringup-end-search",
+                                      "replaces --bringup-margin: give one");
+          }
+          const double stroke_m =
+              config.platform.leg_max_length_m - config.platform.leg_min_length_m;
+          bringup_options.guard = stewart::hw::StrokeEndSearchGuard(
+              config.platform.leg_min_length_m, config.platform.leg_max_length_m,
+              bringup_end_search_m, bringup_options.guard.speed_cap_mps);
+          hw.adc_fault_margin_counts =
+              stewart::hw::FaultMarginForSearch(hw, stroke_m, bringup_end_search_m);
+        }
         return std::nullopt;
       },
       [&](const stewart::StackConfig& config, lcm::LCM* lcm) {
@@ -67,9 +88,11 @@ int main(int argc, char** argv) {
           const stewart::hw::LegGuardLimits& g = bringup_options.guard;
           spdlog::warn(
               "hw_bridge: BRING-UP MODE: {} drives the legs' duty directly, no safety filter; "
-              "guard: {:.4f} m from the stroke ends, leg speed cap {:.4f} m/s; echo on {}",
+              "guard: end zones {:.4f} m inside the stroke ends (negative: beyond them), leg "
+              "speed cap {:.4f} m/s, pots' fault margin {} counts; echo on {}",
               stewart::hw::BringupDutyChannel(config.lcm.channel_prefix, config.lcm.channel_suffix),
-              g.margin_m, g.speed_cap_mps,
+              g.margin_m + g.min_length_m - config.platform.leg_min_length_m, g.speed_cap_mps,
+              config.hw_bridge.adc_fault_margin_counts,
               stewart::hw::BringupAppliedChannel(config.lcm.channel_prefix,
                                                  config.lcm.channel_suffix));
         }

@@ -21,4 +21,20 @@ LegGuardLimits DefaultBringupGuard(double min_length_m, double max_length_m, dou
   return g;
 }
 
+LegGuardLimits StrokeEndSearchGuard(double min_length_m, double max_length_m, double search_m,
+                                    double speed_cap_mps) {
+  constexpr double kEndZoneM = 5e-4;
+  LegGuardLimits g;
+  g.min_length_m = min_length_m - search_m;
+  g.max_length_m = max_length_m + search_m;
+  g.margin_m = kEndZoneM;
+  g.speed_cap_mps = speed_cap_mps;
+  return g;
+}
+
+int FaultMarginForSearch(const HwBridgeConfig& hw, double stroke_m, double search_m) {
+  const double counts_per_m = (hw.adc_extended - hw.adc_retracted).cwiseAbs().maxCoeff() / stroke_m;
+  return hw.adc_fault_margin_counts + static_cast<int>(std::ceil(search_m * counts_per_m));
+}
+
 }  // namespace stewart::hw

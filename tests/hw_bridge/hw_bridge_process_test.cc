@@ -265,5 +265,27 @@ TEST(HwBridgeProcess, BadConfigExitsWithStatus2) {
   EXPECT_EQ(WEXITSTATUS(status), 2);
 }
 
+// The pot calibration's guard flag goes with bring-up and replaces its margin;
+// either misuse stops the bridge before it opens a socket, exit 2.
+TEST(HwBridgeProcess, TheEndSearchFlagOnlyWithBringupAndWithoutAMargin) {
+  const auto exit_code = [](std::vector<std::string> args) {
+    args.insert(args.begin(), HW_BRIDGE_EXE);
+    args.push_back("--log-level");
+    args.push_back("off");
+    std::vector<char*> argv;
+    for (std::string& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    pid_t pid = -1;
+    if (posix_spawn(&pid, argv[0], nullptr, nullptr, argv.data(), environ) != 0) return -1;
+    int status = 0;
+    waitpid(pid, &status, 0);
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  };
+  EXPECT_EQ(exit_code({"--bringup-end-search", "0.004"}), 2);
+  EXPECT_EQ(exit_code({"--bringup", "--bringup-end-search", "0.004", "--bringup-margin", "0.01"}),
+            2);
+  EXPECT_EQ(exit_code({"--bringup", "--bringup-end-search", "-0.004"}), 2);
+}
+
 }  // namespace
 }  // namespace stewart

@@ -44,12 +44,12 @@ class IdentifyActuatorsCli : public WithRunFolder<::testing::Test> {
 
   // stewart_identify with `args` and the P-16P overlay, its output in
   // <run folder>/identify.out.
-  int Identify(const std::string& args, bool lock = false) {
+  int Identify(const std::string& args, bool lock = false, const std::string& mode = "actuators") {
     const std::string guard =
         lock ? "flock " + ShellQuote(std::string(STEWART_BUILD_DIR) + "/stack_launch.lock") + " "
              : "";
     return Shell("cd " + ShellQuote(STEWART_SOURCE_DIR) + " && " + guard + "timeout -k 10 120 " +
-                 ShellQuote(IDENTIFY_PATH) + " --mode actuators " + args + " >" +
+                 ShellQuote(IDENTIFY_PATH) + " --mode " + mode + " " + args + " >" +
                  ShellQuote(Output()) + " 2>&1");
   }
   std::string Output() const { return run_folder_ + "/identify.out"; }
@@ -151,6 +151,67 @@ TEST_F(IdentifyActuatorsCli, AGuardTripStopsTheRunAndWritesNothing) {
   EXPECT_NE(ReadFile(Output()).find("guard: leg 0 speed_cap"), std::string::npos)
       << ReadFile(Output());
   EXPECT_FALSE(std::filesystem::exists(out));
+}
+
+// stewart_identify --mode pots over LCM (docs/hardware.md, "Calibrate the
+// pots at the stroke ends"): the tool starts hw_emulator, whose pots read
+// with scale and offset errors (up to 1.6 mm at the ends), and hw_bridge
+// --bringup --bringup-end-search, takes all six legs to both stroke ends in
+// real time (~47 s) and writes the counts there. The counts the emulator's
+// pots give at the ends follow from the truth and the config's calibration.
+TEST_F(IdentifyActuatorsCli, PotsAtTheStrokeEndsThroughHwBridgeAndTheEmulatorOverLcm) {
+  const Vector6d scale = (Vector6d() << 1.003, 0.998, 1.0, 1.002, 0.997, 1.001).finished();
+  const Vector6d offset_m = (Vector6d() << -0.001, 0.0008, 0.0015, -0.0005, 0.001, 0.0).finished();
+  const std::string truth = Truth(
+      "actuators: {model: dc_motor}\n"
+      "sensors: {leg_scale: [1.003, 0.998, 1.0, 1.002, 0.997, 1.001],\n"
+      "          leg_offset_m: [-0.001, 0.0008, 0.0015, -0.0005, 0.001, 0.0]}\n");
+  const std::string out = run_folder_ + "/pots.yaml";
+  const std::string run_dir = run_folder_ + "/run";
+  ASSERT_EQ(
+      Identify(P16p() + "--plant hw --device-emulator --truth " + ShellQuote(truth) +
+                   " --travel-speed 0.013 --lcm-url " + ShellQuote(PrivateLcmUrl(kHwLcmPort)) +
+                   " --device-port " + std::to_string(kDevicePort) + " --local-port " +
+                   std::to_string(kBridgePort) + " --run-dir " + ShellQuote(run_dir) + " --out " +
+                   ShellQuote(out),
+               true, "pots"),
+      0)
+      << ReadFile(Output()) << ReadFile(run_dir + "/hw_bridge.log");
+  const StackConfig config = LoadStackConfig(DefaultConfigPath(), {DcMotorOverlayPath()});
+  const StackConfig calibrated = LoadStackConfig(DefaultConfigPath(), {DcMotorOverlayPath(), out});
+  const HwBridgeConfig& hw = config.hw_bridge;
+  const double min_m = config.platform.leg_min_length_m;
+  const double stroke_m = config.platform.leg_max_length_m - min_m;
+  for (int i = 0; i < 6; ++i) {
+    const double counts_per_m = (hw.adc_extended(i) - hw.adc_retracted(i)) / stroke_m;
+    // The config's calibration inverted at the pot's reading s L + o.
+    const auto counts_at = [&](double length_m) {
+      return hw.adc_retracted(i) +
+             (scale(i) * length_m + offset_m(i) - min_m - hw.length_offset_m(i)) * counts_per_m;
+    };
+    EXPECT_NEAR(calibrated.hw_bridge.adc_retracted(i), counts_at(min_m), 0.15e-3 * counts_per_m)
+        << "leg " << i;
+    EXPECT_NEAR(calibrated.hw_bridge.adc_extended(i), counts_at(min_m + stroke_m),
+                0.15e-3 * counts_per_m)
+        << "leg " << i;
+  }
+  const std::string bridge_log = ReadFile(run_dir + "/hw_bridge.log");
+  EXPECT_NE(bridge_log.find("BRING-UP MODE"), std::string::npos) << bridge_log;
+  // The bridge's end zones lie beyond the stroke ends, its fault margin wider.
+  EXPECT_NE(bridge_log.find("end zones -0.0035 m"), std::string::npos) << bridge_log;
+  EXPECT_NE(bridge_log.find("fault margin 114 counts"), std::string::npos) << bridge_log;
+  EXPECT_NE(ReadFile(Output()).find("extended ends reached"), std::string::npos);
+}
+
+TEST_F(IdentifyActuatorsCli, PotsNeedTheHardwarePath) {
+  const std::string out = " --out " + ShellQuote(run_folder_ + "/never.yaml");
+  EXPECT_EQ(Identify(P16p() + "--plant sim" + out, false, "pots"), 2);
+  EXPECT_NE(ReadFile(Output()).find("calibration is hw_bridge's"), std::string::npos)
+      << ReadFile(Output());
+  EXPECT_EQ(Identify("--plant hw --device-emulator --in-process" + out, false, "pots"), 2);
+  EXPECT_NE(ReadFile(Output()).find("config/overlays/p16p.yaml"), std::string::npos)
+      << ReadFile(Output());
+  EXPECT_FALSE(std::filesystem::exists(run_folder_ + "/never.yaml"));
 }
 
 }  // namespace

@@ -36,10 +36,18 @@ struct ActuatorModeOptions {
   double speed_cap_mps = -1.0;    ///< default: twice the config motor's full-duty speed
   double coulomb_sigma_n = -1.0;  ///< default: the config's coulomb_friction_n (100 %)
   double sample_timeout_s = 2.0;
+  double end_search_m = -1.0;      ///< pots: default the stroke-end run's
+  double travel_speed_mps = -1.0;  ///< pots: default the stroke-end run's
 };
 
 /// Runs it; returns the process exit code (0, 1 on a guard trip or a
 /// process failure). Throws InputError / IdentificationError for bad input.
 int IdentifyActuators(const ActuatorModeOptions& options);
+
+/// stewart_identify --mode pots: the pots' two-point calibration at the
+/// stroke ends (identify/stroke_end_procedure.h), --plant hw only (the
+/// calibration is hw_bridge's), as an overlay of hw_bridge.adc_retracted and
+/// adc_extended. Same exit codes and throws.
+int IdentifyPots(const ActuatorModeOptions& options);
 
 }  // namespace stewart::identify

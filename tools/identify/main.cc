@@ -8,6 +8,7 @@
 //   stewart_identify --mode payload --log runs/<run>/log.lcm --out identified.yaml
 //   stewart_identify --mode actuators --plant hw --overlay config/overlays/p16p.yaml --out
 //   motors.yaml
+//   stewart_identify --mode pots --plant hw --overlay config/overlays/p16p.yaml --out pots.yaml
 #include <spdlog/spdlog.h>
 #include <sys/wait.h>
 
@@ -162,9 +163,10 @@ int main(int argc, char** argv) {
   stewart::identify::ActuatorModeOptions a;
   app.add_option("--mode", o.mode,
                  "what to identify: payload (the platform body with its load) | actuators (the "
-                 "DC-motor legs, bring-up, before the filter is armed)")
+                 "DC-motor legs, bring-up, before the filter is armed) | pots (the legs' pot "
+                 "calibration at the stroke ends, bring-up, --plant hw)")
       ->required()
-      ->check(CLI::IsMember({"payload", "actuators"}));
+      ->check(CLI::IsMember({"payload", "actuators", "pots"}));
   app.add_option("--out", o.out_path, "overlay file to write")->required();
   app.add_option("--plant", o.plant, "sim | hw (the excitation run's plant)")
       ->check(CLI::IsMember({"sim", "hw"}))
@@ -227,6 +229,12 @@ int main(int argc, char** argv) {
                  "actuators, --plant hw: no sample for this long ends the run (s)")
       ->check(CLI::Range(0.1, 60.0))
       ->capture_default_str();
+  app.add_option("--end-search", a.end_search_m,
+                 "pots: how far beyond a nominal stroke end a reading may go (m, 0.004)")
+      ->check(CLI::Range(0.0015, 0.02));
+  app.add_option("--travel-speed", a.travel_speed_mps,
+                 "pots: the legs' common speed between the ends (m/s, 0.01; slower near them)")
+      ->check(CLI::Range(0.003, 0.03));
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -235,7 +243,7 @@ int main(int argc, char** argv) {
     return status == 0 ? ToInt(ExitCode::kOk) : ToInt(ExitCode::kBadInput);
   }
   try {
-    if (o.mode == "actuators") {
+    if (o.mode == "actuators" || o.mode == "pots") {
       a.plant = o.plant;
       a.device_emulator = o.device_emulator;
       a.out_path = o.out_path;
@@ -245,7 +253,8 @@ int main(int argc, char** argv) {
       a.seed = o.seed;
       a.lcm_url = o.lcm_url;
       a.run_dir = o.run_dir;
-      return stewart::identify::IdentifyActuators(a);
+      return o.mode == "pots" ? stewart::identify::IdentifyPots(a)
+                              : stewart::identify::IdentifyActuators(a);
     }
     return Identify(o);
   } catch (const stewart::InputError& e) {

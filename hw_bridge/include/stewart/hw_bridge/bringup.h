@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <string>
 
+#include "stewart/hw_bridge/hw_bridge_config.h"
 #include "stewart/hw_bridge/leg_guard.h"
 #include "stewart/model/actuator_params.h"
 #include "stewart/model/types.h"
@@ -28,6 +29,21 @@ struct BringupOptions {
 /// when the config has no motor values).
 LegGuardLimits DefaultBringupGuard(double min_length_m, double max_length_m, double margin_m,
                                    const DcMotorParams& motor);
+
+/// The guard of the pot calibration's stroke-end run (hw_bridge --bringup
+/// --bringup-end-search; docs/hardware.md, "Calibrate the pots at the stroke
+/// ends"): end zones half a millimetre wide, search_m beyond the nominal
+/// stroke ends, so that legs whose pots read up to search_m off reach their
+/// end stops.
+LegGuardLimits StrokeEndSearchGuard(double min_length_m, double max_length_m, double search_m,
+                                    double speed_cap_mps);
+
+/// The pots' fault margin (counts) that lets readings search_m beyond a
+/// stroke end through: the config's, plus search_m in counts of the leg with
+/// the most counts per metre. Open (~0) and shorted (~adc_max) wipers stay
+/// faults as long as the result is below the calibrated ends' distance to
+/// them.
+int FaultMarginForSearch(const HwBridgeConfig& hw, double stroke_m, double search_m);
 
 /// What the device applied, from its sensor frame (the bring-up echo).
 struct AppliedDuty {
