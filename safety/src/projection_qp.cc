@@ -35,6 +35,23 @@ template <int MaxRows>
 void Polish(const ProjectionQpN<MaxRows>& qp, const std::array<int, 6>& active, int num_active,
             ProjectionResultN<MaxRows>* res) {
   if (num_active == 0) return;
+  if (num_active == 1) {
+    // One active row a: x = x0 + mu a with a^T x = b, mu = (b - a^T x0) / |a|^2,
+    // and one step of refinement on the residual, as below.
+    const int i = active[0];
+    const Vector6d a = qp.a.row(i).transpose();
+    const double aa = a.squaredNorm();
+    const double rhs = qp.b(i) - a.dot(qp.x0);
+    double mu = rhs / aa;
+    Vector6d dx = mu * a;
+    const double correction = (rhs - a.dot(dx)) / aa;
+    mu += correction;
+    dx += correction * a;
+    if (!dx.allFinite() || !std::isfinite(mu) || mu < 0.0) return;
+    res->x = qp.x0 + dx;
+    res->mu(i) = mu;
+    return;
+  }
   ActiveMatrix n(num_active, 6);
   ActiveVector rhs(num_active);
   for (int j = 0; j < num_active; ++j) {
@@ -85,10 +102,14 @@ ProjectionResultN<MaxRows> SolveProjectionQp(const ProjectionQpN<MaxRows>& qp) {
     int p = -1;
     double worst = 0.0;
     const double x_norm = res.x.norm();
+    // Every row's a_i^T x at once: the rows are stored column-major, so this
+    // is six vectorised passes down the columns instead of m strided dots.
+    Eigen::Matrix<double, MaxRows, 1> ax;
+    ax.head(qp.m).noalias() = qp.a.topRows(qp.m) * res.x;
     for (int i = 0; i < qp.m; ++i) {
       if (is_active[static_cast<size_t>(i)]) continue;
       const double norm = row_norm[static_cast<size_t>(i)];
-      const double slack = qp.a.row(i).dot(res.x) - qp.b(i);
+      const double slack = ax(i) - qp.b(i);
       const double tol = kFeasTol * (std::fabs(qp.b(i)) + norm * x_norm);
       if (slack < -tol && slack / norm < worst) {
         worst = slack / norm;

@@ -2,6 +2,7 @@
 // un-composed QP"): every barrier its own row, solved exactly by the dual
 // active-set method. Kept in its own file: nothing here runs for the other
 // variants.
+#include <Eigen/Core>
 #include <cmath>
 
 #include "stewart/model/linear_algebra6.h"
@@ -39,9 +40,11 @@ bool SafetyFilter::BuildUncomposedQp(const DynamicsTerms& terms, const Vector6d&
                                      const Vector6d& f_des, UncomposedQp* qp,
                                      UncomposedQpRows* rows) const {
   FilterWorkspace ws;  // its own: leaves the data of the filter's step alone
-  if (!ws.barrier.inertia.Compute(terms.M) && constraints_.num_velocity > 0) {
+  ws.barrier.inertia_valid = ws.barrier.inertia.Compute(terms.M);
+  if (!ws.barrier.inertia_valid &&
+      (constraints_.num_velocity > 0 || metric_ != CorrectionMetric::kForce)) {
     qp->m = 0;
-    return false;  // the velocity rows need M^-1
+    return false;  // the velocity rows need M^-1, the acceleration metric L_M
   }
   ws.metric_map = map;
   const bool posable = PoseUncomposedQp(StepInput{terms, qd, f_des, b, kZero6},
@@ -55,7 +58,7 @@ bool SafetyFilter::PoseUncomposedQp(const StepInput& in, ConditionGroups groups,
                                     const FilterWorkspace& ws, UncomposedQpData* out) const {
   const DynamicsTerms& terms = in.terms;
   const BarrierEvaluation& b = in.barriers;
-  const Matrix6d& map = ws.metric_map;
+  const Matrix6d& map = ws.metric_map;  // the force-limit rows' T
   UncomposedQp& qp = out->qp;
   UncomposedQpRows& rows = out->rows;
   rows = UncomposedQpRows{};
@@ -64,34 +67,86 @@ bool SafetyFilter::PoseUncomposedQp(const StepInput& in, ConditionGroups groups,
   const ConstraintSet& c = constraints_;
   const bool force_metric = metric_ == CorrectionMetric::kForce;
   qp.m = 0;
+  // The acceleration metric's map is T = H^-1 L_M (M = L_M L_M^T), so in
+  // y = T^-1 F every normal and y0 need L_M alone, not T:
+  //   y0 = T^-1 F_des = L_M^-1 H F_des,
+  //   T^T (-H^T qd) = -L_M^T qd                 (position rows),
+  //   T^T H^T M^-1 e_j = L_M^T M^-1 e_j = L_M^-1 e_j   (velocity rows),
+  // triangular solves instead of solves with T and 6x6 products.
+  Matrix6d l_m;
+  if (!force_metric) l_m = ws.barrier.inertia.MatrixL();
+  const auto lower = l_m.triangularView<Eigen::Lower>();
   // y = T^-1 F; y0 = T^-1 F_des (F_des itself for the force metric), as BuildQp.
   qp.x0 = in.f_des;
-  if (!force_metric && !SolvePartialPivot6(map, &qp.x0)) qp.x0.setConstant(NAN);
+  if (!force_metric) {
+    if (ws.barrier.inertia_valid) {
+      qp.x0 = terms.H * in.f_des;
+      lower.solveInPlace(qp.x0);
+    } else {
+      qp.x0.setConstant(NAN);
+    }
+  }
   bool posable = true;
 
   if (c.num_position > 0 && groups != ConditionGroups::kVelocityOnly && !b.outside_position_set) {
     // dh_D,i/dF = -H^T qd for every position barrier (the power term): the
-    // rows differ only by alpha_i and their offsets.
-    Vector6d g = -(terms.H.transpose() * in.qd);
-    if (!force_metric) g = map.transpose() * g;
+    // rows share one direction and differ only by alpha_i and their offsets.
+    // Of rows with one normal only the one with the largest offset can bind
+    // (it implies the others), so that one alone is posed: the feasible set,
+    // hence the optimum, is the same, and the others' multipliers are 0.
+    const Vector6d g = force_metric ? Vector6d(-(terms.H.transpose() * in.qd))
+                                    : Vector6d(-(l_m.transpose() * in.qd));
+    const double g_norm = g.norm();
+    const double g_dot_x0 = g.dot(qp.x0);
+    int best = -1;
+    double best_b = 0.0, best_norm = 0.0;
     for (int i = 0; i < c.num_position; ++i) {
-      const size_t k = static_cast<size_t>(i);
-      const double alpha = c.position[k].alpha;
+      const double alpha = c.position[static_cast<size_t>(i)].alpha;
       // alpha_i (dh_i + h_i) - delta_p at F_des (+ friction: barriers.h).
       const double psi = OwnPositionCondition(c, b, i);
-      const ConditionRow r = AppendConditionRow(psi, alpha * g, &qp);
-      posable = posable && r.posable;
-      rows.position_row[k] = r.row;
-      rows.position_norm[k] = r.norm;
+      const double norm = alpha * g_norm;
+      if (!(norm > kZeroNormal)) {
+        posable = posable && !(psi < 0.0);  // the force cannot change it
+        continue;
+      }
+      const double offset = (alpha * g_dot_x0 - psi) / norm;
+      if (best < 0 || offset > best_b) {
+        best = i;
+        best_b = offset;
+        best_norm = norm;
+      }
+    }
+    if (best >= 0) {
+      STEWART_CHECK(qp.m < UncomposedQp::kMaxRows, "PoseUncomposedQp: no row left");
+      const size_t k = static_cast<size_t>(best);
+      qp.a.row(qp.m) = g.transpose() / g_norm;
+      qp.b(qp.m) = best_b;
+      rows.position_row[k] = qp.m++;
+      rows.position_norm[k] = best_norm;
     }
   }
   if (c.num_velocity > 0 && groups != ConditionGroups::kPositionOnly) {
-    // dh_v,i/dF = H^T M^-1 a_i with a_i = sign_i e_axis: column `axis` of
-    // H^T M^-1 (M^-1 is symmetric), mapped to y by T^T.
-    Rhs6<6> m_inv = Rhs6<6>::Identity();
-    ws.barrier.inertia.SolveInPlace<6>(&m_inv);
-    Matrix6d g = terms.H.transpose() * m_inv;
-    if (!force_metric) g = map.transpose() * g;
+    // dh_v,i/dF = H^T M^-1 a_i with a_i = sign_i e_axis, mapped to y by T^T:
+    // column `axis` of H^T M^-1 for the force metric, of L_M^-1 for the
+    // acceleration metric.
+    Matrix6d g;
+    if (force_metric) {
+      Rhs6<6> m_inv = Rhs6<6>::Identity();
+      ws.barrier.inertia.SolveInPlace<6>(&m_inv);
+      g = terms.H.transpose() * m_inv;
+    } else {
+      // L_M^-1, lower triangular, column by column (forward substitution).
+      const Vector6d inv_diag = l_m.diagonal().cwiseInverse();
+      g.setZero();
+      for (int j = 0; j < 6; ++j) {
+        g(j, j) = inv_diag(j);
+        for (int i = j + 1; i < 6; ++i) {
+          double sum = 0.0;
+          for (int k = j; k < i; ++k) sum += l_m(i, k) * g(k, j);
+          g(i, j) = -sum * inv_diag(i);
+        }
+      }
+    }
     for (int i = 0; i < c.num_velocity; ++i) {
       const size_t k = static_cast<size_t>(i);
       const VelocityBarrierSpec& s = c.velocity[k];

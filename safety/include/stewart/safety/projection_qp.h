@@ -80,8 +80,9 @@ ConditionRow AppendConditionRow(double psi, const Vector6d& normal, ProjectionQp
     return r;
   }
   STEWART_CHECK(qp->m < MaxRows, "AppendConditionRow: the QP has no row left");
-  qp->a.row(qp->m) = normal.transpose() / norm;
-  qp->b(qp->m) = (normal.dot(qp->x0) - psi) / norm;
+  const double inv_norm = 1.0 / norm;
+  qp->a.row(qp->m) = normal.transpose() * inv_norm;
+  qp->b(qp->m) = (normal.dot(qp->x0) - psi) * inv_norm;
   r.norm = norm;
   r.row = qp->m++;
   return r;
