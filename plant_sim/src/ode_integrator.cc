@@ -116,7 +116,7 @@ OdeIntegrator::OdeIntegrator(const OdeOptions& options, int size, int num_roots,
     Check(ERKStepSStolerances(m.mem, options.rel_tol, options.abs_tol), erk, "ERKStepSStolerances");
     Check(ERKStepSetOrder(m.mem, options.erk_order), erk, "ERKStepSetOrder");
     Check(ERKStepSetInterpolantType(m.mem, ARK_INTERP_LAGRANGE), erk, "ERKStepSetInterpolantType");
-    Check(ERKStepSetMaxNumSteps(m.mem, 100000), erk, "ERKStepSetMaxNumSteps");
+    Check(ERKStepSetMaxNumSteps(m.mem, options.erk_max_steps), erk, "ERKStepSetMaxNumSteps");
     if (num_roots > 0) {
       Check(ERKStepRootInit(m.mem, num_roots, &Impl::Roots), erk, "ERKStepRootInit");
       Check(ERKStepSetNoInactiveRootWarn(m.mem), erk, "ERKStepSetNoInactiveRootWarn");

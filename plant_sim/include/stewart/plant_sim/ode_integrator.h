@@ -47,6 +47,10 @@ struct OdeOptions {
   double rel_tol = 1e-8;
   double abs_tol = 1e-10;
   int erk_order = 5;  ///< kArkodeErk only: ARKODE's default table of this order (2-8)
+  /// kArkodeErk only: the steps the explicit method may take towards one
+  /// output time before it gives up (Plant then integrates that interval
+  /// with its stiff fallback).
+  long erk_max_steps = 100000;
 };
 
 /// The integrator and tolerances of the `plant_sim` section; throws
