@@ -31,6 +31,71 @@ using ActiveGram = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 6, 6
 // limit, multipliers ~1e7) would square its condition number and leave the
 // constraints violated by ~1e-10 relative. One step of refinement on the
 // residual takes the rest.
+// Householder QR of the 6 x k matrix whose columns are k <= 6 normals, in
+// fixed storage (LAPACK's convention: H_j = I - tau_j v_j v_j^T with
+// v_j(j) = 1, Q = H_0 ... H_{k-1}); the same factors as Eigen's
+// HouseholderQR, without its dynamic-size machinery.
+class NormalsQr {
+ public:
+  explicit NormalsQr(int k) : k_(k) {}
+  double* column(int j) { return a_[j]; }
+
+  void Factor() {
+    for (int j = 0; j < k_; ++j) {
+      double* c = a_[j];
+      double tail = 0.0;
+      for (int i = j + 1; i < 6; ++i) tail += c[i] * c[i];
+      const double head = c[j];
+      if (tail == 0.0) {  // already upper triangular in this column
+        tau_[j] = 0.0;
+        continue;
+      }
+      const double norm = std::sqrt(head * head + tail);
+      const double beta = head >= 0.0 ? -norm : norm;
+      tau_[j] = (beta - head) / beta;
+      const double scale = 1.0 / (head - beta);
+      for (int i = j + 1; i < 6; ++i) c[i] *= scale;
+      c[j] = beta;
+      for (int col = j + 1; col < k_; ++col) {
+        double* d = a_[col];
+        double w = d[j];
+        for (int i = j + 1; i < 6; ++i) w += c[i] * d[i];
+        w *= tau_[j];
+        d[j] -= w;
+        for (int i = j + 1; i < 6; ++i) d[i] -= w * c[i];
+      }
+    }
+  }
+  double r(int i, int j) const { return a_[j][i]; }  // i <= j
+  /// Q [z; 0] for z of length k.
+  Vector6d ApplyQ(const double* z) const {
+    Vector6d y = Vector6d::Zero();
+    for (int j = 0; j < k_; ++j) y(j) = z[j];
+    for (int j = k_ - 1; j >= 0; --j) {
+      const double* c = a_[j];
+      double w = y(j);
+      for (int i = j + 1; i < 6; ++i) w += c[i] * y(i);
+      w *= tau_[j];
+      y(j) -= w;
+      for (int i = j + 1; i < 6; ++i) y(i) -= w * c[i];
+    }
+    return y;
+  }
+
+ private:
+  int k_;
+  double a_[6][6]{};  // a_[j]: column j (the normal, then R above and v below the diagonal)
+  double tau_[6]{};
+};
+
+// Re-solves the final active set directly so the active constraints hold to
+// rounding, whatever the path the iteration took: x = x0 + N^T mu with
+// N N^T mu = b_N - N x0, through the QR factors of N^T = Q R (so that
+// x - x0 = Q R^-T r and mu = R^-1 R^-T r). Not through the Gram N N^T: two
+// nearly parallel active normals (a position row and a velocity row near a
+// limit, multipliers ~1e7) would square its condition number and leave the
+// constraints violated by ~1e-10 relative. One step of refinement on the
+// residual takes the rest.
 template <int MaxRows>
 void Polish(const ProjectionQpN<MaxRows>& qp, const std::array<int, 6>& active, int num_active,
             ProjectionResultN<MaxRows>* res) {
@@ -52,33 +117,49 @@ void Polish(const ProjectionQpN<MaxRows>& qp, const std::array<int, 6>& active, 
     res->mu(i) = mu;
     return;
   }
-  ActiveMatrix n(num_active, 6);
-  ActiveVector rhs(num_active);
-  for (int j = 0; j < num_active; ++j) {
+  const int k = num_active;
+  NormalsQr qr(k);
+  double rhs[6];
+  for (int j = 0; j < k; ++j) {
     const int i = active[static_cast<size_t>(j)];
-    n.row(j) = qp.a.row(i);
-    rhs(j) = qp.b(i) - qp.a.row(i).dot(qp.x0);
+    double* c = qr.column(j);
+    for (int e = 0; e < 6; ++e) c[e] = qp.a(i, e);
+    rhs[j] = qp.b(i) - qp.a.row(i).dot(qp.x0);
   }
-  using Transposed = Eigen::Matrix<double, 6, Eigen::Dynamic, 0, 6, 6>;
-  const Eigen::HouseholderQR<Transposed> qr(Transposed(n.transpose()));
-  const auto r =
-      qr.matrixQR().topLeftCorner(num_active, num_active).template triangularView<Eigen::Upper>();
-  const double r_max = qr.matrixQR().diagonal().head(num_active).cwiseAbs().maxCoeff();
-  if (!(qr.matrixQR().diagonal().head(num_active).cwiseAbs().minCoeff() > 1e-14 * r_max)) return;
+  qr.Factor();
+  double r_max = 0.0, r_min = HUGE_VAL;
+  for (int j = 0; j < k; ++j) {
+    r_max = std::fmax(r_max, std::fabs(qr.r(j, j)));
+    r_min = std::fmin(r_min, std::fabs(qr.r(j, j)));
+  }
+  if (!(r_min > 1e-14 * r_max)) return;
   Vector6d dx = Vector6d::Zero();
-  ActiveVector mu = ActiveVector::Zero(num_active);
-  ActiveVector residual = rhs;
+  double mu[6] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
+  double residual[6];
+  for (int j = 0; j < k; ++j) residual[j] = rhs[j];
   for (int pass = 0; pass < 2; ++pass) {
-    const ActiveVector z = r.transpose().solve(residual);
-    Vector6d z_full = Vector6d::Zero();
-    z_full.head(num_active) = z;
-    dx += qr.householderQ() * z_full;
-    mu += r.solve(z);
-    residual = rhs - n * dx;
+    double z[6];
+    for (int j = 0; j < k; ++j) {  // R^T z = residual
+      double sum = residual[j];
+      for (int i = 0; i < j; ++i) sum -= qr.r(i, j) * z[i];
+      z[j] = sum / qr.r(j, j);
+    }
+    dx += qr.ApplyQ(z);
+    for (int j = k - 1; j >= 0; --j) {  // R dmu = z
+      double sum = z[j];
+      for (int i = j + 1; i < k; ++i) sum -= qr.r(j, i) * z[i];
+      z[j] = sum / qr.r(j, j);
+      mu[j] += z[j];
+    }
+    for (int j = 0; j < k; ++j) {
+      residual[j] = rhs[j] - qp.a.row(active[static_cast<size_t>(j)]).dot(dx);
+    }
   }
-  if (!dx.allFinite() || !mu.allFinite() || (mu.array() < 0.0).any()) return;
+  bool ok = dx.allFinite();
+  for (int j = 0; j < k; ++j) ok = ok && std::isfinite(mu[j]) && !(mu[j] < 0.0);
+  if (!ok) return;
   res->x = qp.x0 + dx;
-  for (int j = 0; j < num_active; ++j) res->mu(active[static_cast<size_t>(j)]) = mu(j);
+  for (int j = 0; j < k; ++j) res->mu(active[static_cast<size_t>(j)]) = mu[j];
 }
 
 }  // namespace
