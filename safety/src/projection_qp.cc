@@ -1,7 +1,6 @@
 #include "stewart/safety/projection_qp.h"
 
 #include <Eigen/Cholesky>
-#include <Eigen/QR>
 #include <algorithm>
 #include <cmath>
 #include <limits>
