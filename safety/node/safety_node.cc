@@ -170,6 +170,8 @@ void SafetyNode::MaybeAnnounce(bool force) {
   m.last_operator_id = last_operator_id_;
   m.last_operator_seq = last_operator_seq_;
   m.last_operator_reply = last_operator_reply_;
+  m.node_faults = sup.faults_received();
+  m.last_node_fault = sup.last_fault_received();
   auth_.Sign(&m);
   lcm_->publish(config_.lcm.channels.supervisor, &m);
   health_.CountOut();

@@ -133,6 +133,8 @@ bool Supervisor::OnOperator(OperatorCommand command, bool processes_healthy,
 }
 
 void Supervisor::OnFault(const std::string& reason) {
+  ++faults_received_;
+  last_fault_received_ = reason;
   const bool first = !fault_latched_;
   fault_latched_ = true;
   if (Moving(state_)) {

@@ -289,6 +289,25 @@ TimeStats ComputeTimeStats(std::vector<int64_t> ns) {
   return s;
 }
 
+std::vector<RecordedNodeFault> RecordedNodeFaults(
+    const std::vector<supervisor_state_t>& announcements) {
+  std::vector<RecordedNodeFault> faults;
+  int64_t session = 0;
+  int64_t heard = 0;
+  for (const supervisor_state_t& a : announcements) {
+    if (a.session_id != session || a.node_faults < heard) {
+      session = a.session_id;
+      heard = 0;
+    }
+    if (a.node_faults > heard) {
+      faults.push_back(
+          {a.sample_utime, a.last_node_fault, static_cast<long>(a.node_faults - heard - 1)});
+      heard = a.node_faults;
+    }
+  }
+  return faults;
+}
+
 SafetyReplayResult ReplaySafety(const StackConfig& config, const RecordedLog& log,
                                 safety::ReferenceQpSolver* reference) {
   SafetyReplayResult r;
@@ -379,6 +398,9 @@ SafetyReplayResult ReplaySafety(const StackConfig& config, const RecordedLog& lo
         ++r.fallback_stale_input;
       } else if (out.fallback_reason == kCommandInvalidInput) {
         ++r.fallback_invalid_state;
+      } else if (out.mode.state != safety::SupervisorState::kArming &&
+                 out.mode.state != safety::SupervisorState::kArmed) {
+        ++r.fallback_supervisor_stop;
       } else {
         ++r.fallback_by_filter;
       }
@@ -407,10 +429,27 @@ SafetyReplayResult ReplaySafety(const StackConfig& config, const RecordedLog& lo
     return log.nominal[nominal_next].seq > expected;
   };
   r.steps.reserve(log.nominal.size());
-  // What the live supervisor heard besides states and nominal commands:
-  // the operator's commands and the heartbeats, in log order (heartbeat
-  // silence judged on the logger's receive times, an approximation of the
-  // live process's clock).
+  // The faults the live node reported to its supervisor (heartbeats, a
+  // stall, the dead-man) were judged on its wall clock: the recorded
+  // announcements say which and after which sample, and the replay's
+  // supervisor hears each between the same two outputs. Without any
+  // announcement in the log, they are judged again from the recorded
+  // heartbeats on the logger's receive times, an approximation.
+  const std::vector<RecordedNodeFault> node_faults = RecordedNodeFaults(log.supervisor);
+  const bool faults_from_record = !log.supervisor.empty();
+  r.node_faults_from_record = faults_from_record;
+  size_t node_fault_next = 0;
+  auto hear_recorded_faults = [&] {
+    while (node_fault_next < node_faults.size() &&
+           node_faults[node_fault_next].after_sample_utime <= process.supervisor().sample_utime()) {
+      process.supervisor().OnFault(node_faults[node_fault_next].reason);
+      r.node_faults.push_back(node_faults[node_fault_next]);
+      ++node_fault_next;
+    }
+  };
+  // What else the live supervisor heard: the operator's commands and the
+  // heartbeats, in log order (whether the processes were healthy when an
+  // operator armed is judged on the logger's receive times).
   safety::ProcessMonitor monitor(config.supervisor.required_processes,
                                  std::llround(config.supervisor.heartbeat_timeout_s * 1e6));
   for (size_t e = 0; e < log.order.size(); ++e) {
@@ -421,7 +460,7 @@ SafetyReplayResult ReplaySafety(const StackConfig& config, const RecordedLog& lo
         state == safety::SupervisorState::kArming || state == safety::SupervisorState::kArmed,
         timestamp_us);
     for (const std::string& fault : monitor.CheckSilence(timestamp_us)) {
-      process.supervisor().OnFault(fault);
+      if (!faults_from_record) process.supervisor().OnFault(fault);
     }
     if (channel == Channel::kOperator) {
       const operator_command_t& op = log.operator_commands[static_cast<size_t>(index)];
@@ -437,9 +476,11 @@ SafetyReplayResult ReplaySafety(const StackConfig& config, const RecordedLog& lo
     if (channel == Channel::kHealth) {
       const health_t& h = log.health[static_cast<size_t>(index)];
       const std::string fault = monitor.OnHeartbeat(h.name, h.state, h.seq, timestamp_us);
-      if (!fault.empty()) process.supervisor().OnFault(fault);
+      if (!fault.empty() && !faults_from_record) process.supervisor().OnFault(fault);
       continue;
     }
+    if (channel != Channel::kStateEstimate && channel != Channel::kCommandNominal) continue;
+    hear_recorded_faults();
     safety::SafetyOutput out;
     if (channel == Channel::kStateEstimate) {
       ++r.states;
@@ -460,7 +501,8 @@ SafetyReplayResult ReplaySafety(const StackConfig& config, const RecordedLog& lo
     if (IsFallback(recorded.flags)) ++r.fallback_commands;
   }
   r.fallback_without_input = r.fallback_commands - r.fallback_stale_input -
-                             r.fallback_invalid_state - r.fallback_by_filter;
+                             r.fallback_invalid_state - r.fallback_supervisor_stop -
+                             r.fallback_by_filter;
   return r;
 }
 

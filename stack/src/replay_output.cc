@@ -74,13 +74,20 @@ ordered_json ToJson(const SafetyReplayResult& s, const std::string& variant_sour
   j.update(ToJson(s.filter, "_n"));
   j["flags_differ"] = s.flags_differ;
   j["diagnostics_differ"] = s.diagnostics_differ;
-  ordered_json fallback = {{"recorded", s.fallback_commands},
-                           {"stale_input", s.fallback_stale_input},
-                           {"invalid_state", s.fallback_invalid_state},
-                           {"by_filter", s.fallback_by_filter},
-                           {"without_input", s.fallback_without_input}};
+  ordered_json fallback = {
+      {"recorded", s.fallback_commands},           {"stale_input", s.fallback_stale_input},
+      {"invalid_state", s.fallback_invalid_state}, {"supervisor_stop", s.fallback_supervisor_stop},
+      {"by_filter", s.fallback_by_filter},         {"without_input", s.fallback_without_input}};
   fallback.update(ToJson(s.fallback, "_n"));
   j["fallback"] = fallback;
+  ordered_json node_faults = ordered_json::array();
+  for (const RecordedNodeFault& f : s.node_faults) {
+    node_faults.push_back({{"after_sample_utime", f.after_sample_utime},
+                           {"reason", f.reason},
+                           {"unnamed", f.unnamed}});
+  }
+  j["node_faults"] = {{"source", s.node_faults_from_record ? "recorded" : "heartbeats"},
+                      {"heard", node_faults}};
   j["compute_ns"] = {{"replayed", ToJson(s.replayed_ns)}, {"recorded", ToJson(s.recorded_ns)}};
   ordered_json cases;
   for (size_t i = 0; i < s.replayed_cases.size(); ++i) {
@@ -300,10 +307,21 @@ std::string FormatSummary(const ReplayReport& report) {
         "compared below)\n",
         s.answered_by_fallback);
     o += fmt::format(
-        "  fallback commands     {} recorded: {} stale input, {} invalid state, {} filter last "
-        "resort, {} not replayable; {}; {}\n",
-        s.fallback_commands, s.fallback_stale_input, s.fallback_invalid_state, s.fallback_by_filter,
-        s.fallback_without_input, Identical(s.fallback), Worst(s.fallback, "N"));
+        "  fallback commands     {} recorded: {} stale input, {} invalid state, {} supervisor "
+        "stop, {} filter last resort, {} not replayable; {}; {}\n",
+        s.fallback_commands, s.fallback_stale_input, s.fallback_invalid_state,
+        s.fallback_supervisor_stop, s.fallback_by_filter, s.fallback_without_input,
+        Identical(s.fallback), Worst(s.fallback, "N"));
+    if (!s.node_faults_from_record) {
+      o += "  node faults           no supervisor announcements in the log: heartbeat faults "
+           "judged on the logger's receive times, stalls and the dead-man not replayed\n";
+    }
+    for (const RecordedNodeFault& f : s.node_faults) {
+      o += fmt::format("  node fault            after sample {:.6f} s: {}{}\n",
+                       static_cast<double>(f.after_sample_utime) * 1e-6, f.reason,
+                       f.unnamed > 0 ? fmt::format(" (and {} the log does not name)", f.unnamed)
+                                     : std::string());
+    }
     if (s.log_gap > 0) {
       o += fmt::format(
           "  log gap               {} watchdog fallbacks of the replay where the log lacks "

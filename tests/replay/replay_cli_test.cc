@@ -30,6 +30,7 @@
 #include "stewart/safety/safety_process.h"
 #include "stewart/safety_diagnostics_t.hpp"
 #include "stewart/state_t.hpp"
+#include "stewart/supervisor_state_t.hpp"
 #include "stewart/test_support/lcm_messages.h"
 
 namespace stewart {
@@ -66,6 +67,7 @@ constexpr int kInitializing = 5;  // first samples: estimator initialising -> no
 // a fallback before its nominal command arrives.
 constexpr int kStaleSample = 180;
 constexpr int64_t kPauseUs = 25'000;
+constexpr const char* kStallReason = "safety process stalled: a state waited 140 ms to be read";
 
 class ReplayCli : public ::testing::Test {
  protected:
@@ -92,9 +94,13 @@ class ReplayCli : public ::testing::Test {
   /// lcm-logger loses a burst (the process still had them); with
   /// `tamper_case_sample` >= 0 that sample's recorded diagnostics name
   /// another case; with `restart_sample` >= 0 the live safety process
-  /// restarts before that sample (a new process: seq from 0, DISARMED).
+  /// restarts before that sample (a new process: seq from 0, DISARMED); with
+  /// `node_fault_sample` >= 0 the live node reports a fault (a stall) to its
+  /// supervisor after that sample's state arrived and before it is read, and
+  /// announces it on the supervisor channel unless `announce_fault` is false.
   std::string MakeRun(const std::string& name, int tamper_sample = -1, int drop_from = -1,
-                      int drop_count = 0, int tamper_case_sample = -1, int restart_sample = -1) {
+                      int drop_count = 0, int tamper_case_sample = -1, int restart_sample = -1,
+                      int node_fault_sample = -1, bool announce_fault = true) {
     const std::string run = root_ + "/" + name;
     fs::create_directories(run);
     const std::string config_path = std::string(STEWART_SOURCE_DIR) + "/config/platform.yaml";
@@ -155,6 +161,20 @@ class ReplayCli : public ::testing::Test {
       state.status = k < kInitializing ? int32_t{state_t::STATUS_INITIALIZING}
                                        : int32_t{state_t::STATUS_VALID};
       if (!dropped) test::AppendToLog(&log, ch.state_estimate, state, timestamp++);
+      if (k == node_fault_sample) {
+        // As SafetyNode::Fault: the supervisor hears it, the node announces it.
+        safety::Supervisor& supervisor = process.supervisor();
+        supervisor.OnFault(kStallReason);
+        supervisor_state_t announcement{};
+        announcement.utime = supervisor.utime();
+        announcement.sample_utime = supervisor.sample_utime();
+        announcement.session_id = 7;
+        announcement.state = static_cast<int8_t>(supervisor.state());
+        announcement.reason = supervisor.reason();
+        announcement.node_faults = supervisor.faults_received();
+        announcement.last_node_fault = supervisor.last_fault_received();
+        if (announce_fault) test::AppendToLog(&log, ch.supervisor, announcement, timestamp++);
+      }
       safety::SafetyOutput out;
       if (process.OnState(FromMessage(state), &out)) publish(out, k, dropped);
       if (k < kInitializing) continue;  // the controller waits for a valid estimate
@@ -166,7 +186,7 @@ class ReplayCli : public ::testing::Test {
       if (!dropped) test::AppendToLog(&log, ch.command_nominal, nominal, timestamp++);
       if (process.OnNominal(FromMessage(nominal), &out)) publish(out, k, dropped);
     }
-    if (restart_sample < 0) {
+    if (restart_sample < 0 && node_fault_sample < 0) {
       // The process made what the assertions below count.
       EXPECT_EQ(counters_ptr->counter("fallback_commands"), kInitializing + 1);
       EXPECT_EQ(counters_ptr->counter("rejected_nominal_already_answered"), 1);
@@ -387,6 +407,49 @@ TEST_F(ReplayCli, ARestartedProcessIsNamedFirstAndItsDifferencesAttributedToIt) 
   EXPECT_NE(r.output.find(std::to_string(differing) + " of them after the restart of"),
             std::string::npos)
       << r.output;
+}
+
+// The live node held the platform for a fault judged on its wall clock (a
+// stall, here): nothing in the states or commands shows it. The replay's
+// supervisor hears it from the recorded announcement, between the same two
+// outputs, so the HOLD's commands replay bit-identically.
+TEST_F(ReplayCli, AFaultTheNodeAnnouncedIsHeardAtTheSampleItFollowed) {
+  constexpr int kFault = 100;
+  CommandResult r;
+  const nlohmann::json j =
+      ReplayJson(MakeRun("run", -1, -1, 0, -1, -1, kFault), "--expect-identical", &r);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const nlohmann::json& s = j.at("safety");
+  EXPECT_EQ(s.at("node_faults").at("source"), "recorded");
+  ASSERT_EQ(s.at("node_faults").at("heard").size(), 1u) << s.at("node_faults");
+  const nlohmann::json& fault = s.at("node_faults").at("heard").at(0);
+  EXPECT_EQ(fault.at("reason"), kStallReason);
+  EXPECT_EQ(fault.at("after_sample_utime"), 1000 * kFault);  // sample kFault - 1
+  // From the fault on, the supervisor's stop answers every sample but the
+  // watchdog's (kStaleSample: a stale input first).
+  EXPECT_EQ(s.at("fallback").at("supervisor_stop"), kSamples - kFault - 1);
+  EXPECT_EQ(s.at("fallback").at("stale_input"), 1);
+  EXPECT_EQ(s.at("fallback").at("identical"), s.at("fallback").at("compared"));
+  EXPECT_EQ(s.at("identical"), s.at("compared"));
+  EXPECT_NE(
+      r.output.find(std::string("node fault            after sample 0.100000 s: ") + kStallReason),
+      std::string::npos)
+      << r.output;
+}
+
+// The same run without the announcement (a log that lacks it): the replay
+// cannot know of the fault and its commands differ from the HOLD's.
+TEST_F(ReplayCli, AFaultTheLogDoesNotAnnounceIsNotReplayed) {
+  constexpr int kFault = 100;
+  CommandResult r;
+  const nlohmann::json j =
+      ReplayJson(MakeRun("run", -1, -1, 0, -1, -1, kFault, false), "--expect-identical", &r);
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  const nlohmann::json& s = j.at("safety");
+  EXPECT_EQ(s.at("node_faults").at("source"), "heartbeats");
+  EXPECT_TRUE(s.at("node_faults").at("heard").empty());
+  EXPECT_LT(s.at("fallback").at("identical").get<long>(),
+            s.at("fallback").at("compared").get<long>());
 }
 
 TEST_F(ReplayCli, OneUlpDifferenceFailsExpectIdentical) {

@@ -8,7 +8,9 @@
 //   - the controller replay is bit-identical to the recorded nominal commands;
 //   - the estimator replay is bit-identical to the recorded estimates, up to
 //     the first input lcm-logger lost if it lost any (see below).
-// The report has its "Closed form vs QP reference" section.
+// The report has its "Closed form vs QP reference" section. And a run whose
+// safety process was stopped for 0.3 s (held for the stall its node judged on
+// the wall clock) replays bit-identically, HOLD included.
 //
 // On a failure the temporary run folder is kept and its path printed.
 #include <gtest/gtest.h>
@@ -222,6 +224,64 @@ TEST_F(ReplayStack, LockstepRunReplaysBitIdentically) {
   EXPECT_NE(report.find("## Closed form vs QP reference"), std::string::npos) << report;
   EXPECT_NE(report.find("reproduces the recorded commands: yes, bit-identical"), std::string::npos)
       << report;
+}
+
+// The safety process stopped for 0.3 s (SIGSTOP, as a starved CPU would)
+// while the platform moves: the states wait, the node judges the stall on its
+// wall clock and its supervisor holds. Nothing in the states or commands
+// shows why; the announcement on the supervisor channel does, and the replay
+// hears the same fault between the same two commands, so the whole run,
+// HOLD included, replays bit-identically.
+TEST_F(ReplayStack, AStalledSafetyProcessHoldsAndReplaysBitIdentically) {
+  constexpr int kPort = kLcmPort + 1;
+  const std::string json = run_folder_ + "/stalled.json";
+  nlohmann::json j;
+  std::string run;
+  for (int attempt = 1; attempt <= kAttempts; ++attempt) {
+    run = run_folder_ + "/stalled" + std::to_string(attempt);
+    // Once the log holds ~1.4 s of stack time (4 MB; ~2.9 MB per second of
+    // it: the platform moves by then, however loaded the host), the safety
+    // process of this run (its URL's port) stops for 0.3 s. ([/]: the
+    // pattern must not match this shell's own command line.)
+    const std::string stall =
+        "( for i in $(seq 1500); do [ $(stat -c %s " + ShellQuote(run + "/log.lcm") +
+        " 2>/dev/null || echo 0) -gt 4000000 ] && break; sleep 0.02; done; pid=$(pgrep -f "
+        "'[/]safety --config .*:" +
+        std::to_string(kPort) +
+        "'); [ -n \"$pid\" ] && kill -STOP $pid && sleep 0.3 && kill -CONT $pid ) "
+        ">/dev/null 2>&1 &";
+    ASSERT_EQ(Shell(stall), 0);
+    const LaunchResult launch =
+        RunLauncher("--no-build --scenario paper --duration " + FormatNumber(kDurationS), kPort,
+                    run, run_folder_ + "/stalled_launch" + std::to_string(attempt) + ".out");
+    ASSERT_EQ(launch.exit_code, 0) << LaunchFailure(launch);
+    const int exit_code =
+        Replay(run, "--controller --expect-identical --json " + ShellQuote(json), "stalled");
+    j = nlohmann::json::parse(ReadFile(json));
+    ASSERT_EQ(exit_code, 0) << ReadFile(run_folder_ + "/stalled.out");
+    // Retried when the logger lost messages (see above), or when the stall
+    // missed the motion (a loaded host started the stack late).
+    if (TotalMissing(j) == 0 && !j.at("safety").at("node_faults").at("heard").empty()) break;
+    std::printf("[replay] stalled attempt %d: lcm-logger lost %ld messages, %zu node faults\n",
+                attempt, TotalMissing(j), j.at("safety").at("node_faults").at("heard").size());
+  }
+  std::printf("%s", ReadFile(run_folder_ + "/stalled.out").c_str());
+  const nlohmann::json& s = j.at("safety");
+  EXPECT_EQ(s.at("node_faults").at("source"), "recorded");
+  ASSERT_FALSE(s.at("node_faults").at("heard").empty());
+  EXPECT_NE(s.at("node_faults")
+                .at("heard")
+                .at(0)
+                .at("reason")
+                .get<std::string>()
+                .find("safety process stalled"),
+            std::string::npos)
+      << s.at("node_faults");
+  EXPECT_GT(s.at("fallback").at("supervisor_stop").get<long>(), 0);
+  EXPECT_EQ(s.at("fallback").at("identical"), s.at("fallback").at("compared"));
+  EXPECT_EQ(s.at("identical"), s.at("compared"));
+  EXPECT_EQ(s.at("diagnostics_differ"), 0);
+  EXPECT_EQ(j.at("controller").at("identical"), j.at("controller").at("compared"));
 }
 
 }  // namespace

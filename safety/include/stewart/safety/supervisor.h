@@ -146,6 +146,9 @@ class Supervisor {
   /// or went silent; the operator's dead-man). Latches HOLD when ARMING or
   /// ARMED; remembered as the unacknowledged fault in any state.
   void OnFault(const std::string& reason);
+  /// OnFault calls since start, and the latest one's reason ("" before any).
+  int64_t faults_received() const { return faults_received_; }
+  const std::string& last_fault_received() const { return last_fault_received_; }
 
   /// The fault of a safety process that did not run: the state it reads now
   /// arrived `waited_us` (wall time) ago. While ARMING or ARMED a wait
@@ -188,6 +191,8 @@ class Supervisor {
   int64_t fallback_since_utime_ = -1;  ///< first step of the current run of fallbacks
   int64_t hold_since_utime_ = -1;      ///< first step in the current HOLD (-1: none yet)
   int64_t transitions_ = 0;
+  int64_t faults_received_ = 0;
+  std::string last_fault_received_;
   double blend_ = 0.0;
   SupervisorStep last_step_{};
   bool has_step_ = false;

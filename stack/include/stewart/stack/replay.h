@@ -191,6 +191,23 @@ struct SafetyStep {
   int64_t recorded_ns = -1;  ///< recorded safety_diagnostics_t.compute_ns, -1 if absent
 };
 
+/// A fault the live safety node reported to its supervisor from outside the
+/// filter (supervisor_state_t.node_faults went up): its reason and the
+/// sample of the newest output before it.
+struct RecordedNodeFault {
+  int64_t after_sample_utime = 0;
+  std::string reason;
+  /// Faults of the same announcement's count step whose reasons the log
+  /// lacks (announcements the logger lost): heard as one.
+  long unnamed = 0;
+};
+
+/// Every node fault the recorded supervisor announcements show, in order.
+/// A restarted safety process (its count falls, or another session) counts
+/// from zero again.
+std::vector<RecordedNodeFault> RecordedNodeFaults(
+    const std::vector<supervisor_state_t>& announcements);
+
 struct SafetyReplayResult {
   SafetyVariant variant = SafetyVariant::kClosedForm;
   std::string qp_solver;  ///< name of the reference solver for variant qp, else ""
@@ -218,14 +235,20 @@ struct SafetyReplayResult {
   /// Every recorded fallback command (FLAG_FALLBACK or FLAG_STALE_INPUT), by
   /// the path the replayed process took for it (kFallback steps).
   long fallback_commands = 0;
-  long fallback_stale_input = 0;    ///< watchdog or stale nominal (FLAG_STALE_INPUT)
-  long fallback_invalid_state = 0;  ///< state not usable (estimator initialising, diverged)
-  long fallback_by_filter = 0;      ///< the filter's own last resort (infeasible, invalid F_des)
-  long fallback_without_input = 0;  ///< not replayed: its inputs are not in the log
-  DiffStats fallback;               ///< kFallback: replay vs recorded
+  long fallback_stale_input = 0;      ///< watchdog or stale nominal (FLAG_STALE_INPUT)
+  long fallback_invalid_state = 0;    ///< state not usable (estimator initialising, diverged)
+  long fallback_supervisor_stop = 0;  ///< the supervisor's stop (HOLD, ESTOP, DISARMED)
+  long fallback_by_filter = 0;        ///< the filter's own last resort (infeasible, invalid F_des)
+  long fallback_without_input = 0;    ///< not replayed: its inputs are not in the log
+  DiffStats fallback;                 ///< kFallback: replay vs recorded
   /// kLogGap: watchdog fallbacks of the replay while the log lacked nominal
   /// commands (a seq gap) the live process had received.
   long log_gap = 0;
+  /// The live node's faults the replayed supervisor heard, from the recorded
+  /// announcements (node_faults_from_record), else judged again from the
+  /// recorded heartbeats.
+  bool node_faults_from_record = false;
+  std::vector<RecordedNodeFault> node_faults;
 
   TimeStats replayed_ns;  ///< filter time of the replay, over the compared steps
   TimeStats recorded_ns;  ///< the live filter's (safety_diagnostics_t.compute_ns), same steps
