@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <set>
 
+#include "sample_checks.h"
 #include "stewart/identify/ramp_start.h"
 
 namespace stewart::identify {
@@ -73,33 +74,22 @@ class Runner {
 
 const ActuatorSample& Runner::Next() {
   const ActuatorSample s = device_->NextSample();
-  const std::string at = " at utime " + std::to_string(s.utime);
-  if (have_sample_ && s.utime <= last_utime_) {
-    Fail("the device's sample time went backwards" + at + " (previous " +
-         std::to_string(last_utime_) + ")");
+  if (const auto why = detail::UnusableSample(s, have_sample_, last_utime_, "")) {
+    Fail(*why);
   }
   have_sample_ = true;
   last_utime_ = s.utime;
-  for (int i = 0; i < kNumLegs; ++i) {
-    if (!std::isfinite(s.leg_length_m(i))) {
-      Fail("non-finite reading of leg " + std::to_string(i) + at + ": zero duty sent");
-    }
-  }
-  if (!s.valid) Fail("the device flags the sample" + at + " (a leg or pot fault): zero duty sent");
   record_->samples.push_back(s);
   const uint8_t tripped = guard_.Update(s.utime, s.leg_length_m);
   for (int i = 0; i < kNumLegs; ++i) {
     if ((tripped >> i) & 1U) Trip(i, guard_.reason(i));
   }
-  if (s.device_guard_mask != 0) {
-    for (int i = 0; i < kNumLegs; ++i) {
-      if ((s.device_guard_mask >> i) & 1U) {
-        SendZero();
-        throw GuardTrip(i, hw::GuardReason::kNone, s.leg_length_m(i), guard_.speed_mps(i), s.utime,
-                        "the device's guard (hw_bridge --bringup) holds leg " + std::to_string(i) +
-                            " at zero duty" + at + ": zero duty sent to every leg");
-      }
-    }
+  if (const int leg = detail::DeviceGuardLeg(s); leg >= 0) {
+    SendZero();
+    throw GuardTrip(
+        leg, hw::GuardReason::kNone, s.leg_length_m(leg), guard_.speed_mps(leg), s.utime,
+        "the device's guard (hw_bridge --bringup) holds leg " + std::to_string(leg) +
+            " at zero duty" + detail::AtUtime(s.utime) + ": zero duty sent to every leg");
   }
   return record_->samples.back();
 }

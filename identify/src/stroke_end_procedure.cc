@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <vector>
 
+#include "sample_checks.h"
 #include "stewart/hw_bridge/bringup.h"
 #include "stewart/identify/inertial_fit.h"
 #include "stewart/model/dc_motor.h"
@@ -75,21 +76,17 @@ class EndRunner {
 
 const ActuatorSample& EndRunner::Next() {
   const ActuatorSample s = device_->NextSample();
-  const std::string at = " at utime " + std::to_string(s.utime);
-  if (have_sample_ && s.utime <= last_utime_) {
-    Fail("the device's sample time went backwards" + at + " (previous " +
-         std::to_string(last_utime_) + ")");
+  const std::string at = detail::AtUtime(s.utime);
+  if (const auto why = detail::UnusableSample(
+          s, have_sample_, last_utime_,
+          ": a reading outside the calibrated span by more than the fault margin; calibrate that "
+          "leg by hand, docs/hardware.md step 2")) {
+    Fail(*why);
   }
   if (!have_sample_) first_utime_ = s.utime;
   have_sample_ = true;
   last_utime_ = s.utime;
   ++samples_;
-  if (!s.leg_length_m.allFinite()) Fail("a non-finite leg reading" + at + ": zero duty sent");
-  if (!s.valid) {
-    Fail("the device flags the sample" + at +
-         " (a leg or pot fault: a reading outside the calibrated span by more than the fault "
-         "margin; calibrate that leg by hand, docs/hardware.md step 2): zero duty sent");
-  }
   const uint8_t tripped = guard_.Update(s.utime, s.leg_length_m);
   for (int i = 0; i < kNumLegs; ++i) {
     if ((tripped >> i) & 1U) {
@@ -109,8 +106,7 @@ const ActuatorSample& EndRunner::Next() {
                           ": zero duty sent to every leg");
     }
   }
-  if (s.device_guard_mask != 0) {
-    const int leg = __builtin_ctz(s.device_guard_mask);
+  if (const int leg = detail::DeviceGuardLeg(s); leg >= 0) {
     SendZero();
     throw GuardTrip(leg, hw::GuardReason::kNone, s.leg_length_m(leg), guard_.speed_mps(leg),
                     s.utime,
