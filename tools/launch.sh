@@ -260,6 +260,9 @@ SIMULATED=$([[ $PLANT == sim || $EMULATOR == 1 ]] && echo true || echo false)
   echo "  auth_key_file: \"$OUT/auth.key\""
   echo "supervisor:"
   echo "  auto_arm: $SIMULATED"
+  # In lockstep the plant waits for the stack's command: a safety process
+  # that reads a state late (a loaded host) stalls nothing, and is no fault.
+  [[ $MODE == lockstep ]] && echo "  stall_check: false"
 } >"$OUT/launch-overlay.yaml"
 OVERLAY_ARGS=(--overlay "$OUT/launch-overlay.yaml")
 for f in "${OVERLAYS[@]}"; do OVERLAY_ARGS+=(--overlay "$f"); done

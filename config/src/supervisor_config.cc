@@ -9,6 +9,7 @@ safety::SupervisorConfig ParseSupervisorConfig(const ConfigNode& supervisor) {
   c.arming_ramp_s = supervisor.NonNegativeDouble("arming_ramp_s");
   c.auto_arm = supervisor.Bool("auto_arm");
   c.fallback_latch_s = supervisor.NonNegativeDouble("fallback_latch_s");
+  c.stall_check = supervisor.Bool("stall_check");
   c.hold_drive_off = supervisor.Bool("hold_drive_off");
   c.hold_brake_s = supervisor.NonNegativeDouble("hold_brake_s");
   c.heartbeat_timeout_s = supervisor.PositiveDouble("heartbeat_timeout_s");

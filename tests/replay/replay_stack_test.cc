@@ -10,7 +10,8 @@
 //     the first input lcm-logger lost if it lost any (see below).
 // The report has its "Closed form vs QP reference" section. And a run whose
 // safety process was stopped for 0.3 s (held for the stall its node judged on
-// the wall clock) replays bit-identically, HOLD included.
+// the wall clock) replays bit-identically, HOLD included; in lockstep (the
+// plant waits) the same stall is no fault.
 //
 // On a failure the temporary run folder is kept and its path printed.
 #include <gtest/gtest.h>
@@ -80,6 +81,22 @@ class ReplayStack : public WithRunFolder<::testing::Test> {
                  ShellQuote(run_folder_ + "/" + name + ".out") + " 2>&1");
   }
 };
+
+/// In the background: once `run`'s log holds ~1.4 s of stack time (4 MB;
+/// ~2.9 MB per second of it: the platform moves by then, however loaded the
+/// host), the safety process of the run on `port` (its URL) stops for 0.3 s
+/// (SIGSTOP, as a starved CPU would), then `run`.stalled is written. ([/]:
+/// the pattern must not match this shell's own command line.)
+int StallSafetyMidRun(const std::string& run, int port) {
+  return Shell("( for i in $(seq 1500); do [ $(stat -c %s " + ShellQuote(run + "/log.lcm") +
+               " 2>/dev/null || echo 0) -gt 4000000 ] && break; sleep 0.02; done; pid=$(pgrep -f "
+               "'[/]safety --config .*:" +
+               std::to_string(port) +
+               "'); [ -n \"$pid\" ] && kill -STOP $pid && sleep 0.3 && kill -CONT $pid && touch " +
+               ShellQuote(run + ".stalled") + " ) >/dev/null 2>&1 &");
+}
+
+bool Exists(const std::string& path) { return std::ifstream(path).good(); }
 
 /// Messages of all channels lcm-logger lost.
 long TotalMissing(const nlohmann::json& replay) {
@@ -235,25 +252,19 @@ TEST_F(ReplayStack, LockstepRunReplaysBitIdentically) {
 TEST_F(ReplayStack, AStalledSafetyProcessHoldsAndReplaysBitIdentically) {
   constexpr int kPort = kLcmPort + 1;
   const std::string json = run_folder_ + "/stalled.json";
+  const std::string stall_check_overlay = run_folder_ + "/stall_check.yaml";
+  std::ofstream(stall_check_overlay) << "supervisor:\n  stall_check: true\n";
   nlohmann::json j;
   std::string run;
   for (int attempt = 1; attempt <= kAttempts; ++attempt) {
     run = run_folder_ + "/stalled" + std::to_string(attempt);
-    // Once the log holds ~1.4 s of stack time (4 MB; ~2.9 MB per second of
-    // it: the platform moves by then, however loaded the host), the safety
-    // process of this run (its URL's port) stops for 0.3 s. ([/]: the
-    // pattern must not match this shell's own command line.)
-    const std::string stall =
-        "( for i in $(seq 1500); do [ $(stat -c %s " + ShellQuote(run + "/log.lcm") +
-        " 2>/dev/null || echo 0) -gt 4000000 ] && break; sleep 0.02; done; pid=$(pgrep -f "
-        "'[/]safety --config .*:" +
-        std::to_string(kPort) +
-        "'); [ -n \"$pid\" ] && kill -STOP $pid && sleep 0.3 && kill -CONT $pid ) "
-        ">/dev/null 2>&1 &";
-    ASSERT_EQ(Shell(stall), 0);
+    ASSERT_EQ(StallSafetyMidRun(run, kPort), 0);
+    // In lockstep a stall is no fault (supervisor.stall_check false: the
+    // plant waits); turned on here, the supervisor judges it as in real time.
     const LaunchResult launch =
-        RunLauncher("--no-build --scenario paper --duration " + FormatNumber(kDurationS), kPort,
-                    run, run_folder_ + "/stalled_launch" + std::to_string(attempt) + ".out");
+        RunLauncher("--no-build --scenario paper --duration " + FormatNumber(kDurationS) +
+                        " --overlay " + ShellQuote(stall_check_overlay),
+                    kPort, run, run_folder_ + "/stalled_launch" + std::to_string(attempt) + ".out");
     ASSERT_EQ(launch.exit_code, 0) << LaunchFailure(launch);
     const int exit_code =
         Replay(run, "--controller --expect-identical --json " + ShellQuote(json), "stalled");
@@ -282,6 +293,38 @@ TEST_F(ReplayStack, AStalledSafetyProcessHoldsAndReplaysBitIdentically) {
   EXPECT_EQ(s.at("identical"), s.at("compared"));
   EXPECT_EQ(s.at("diagnostics_differ"), 0);
   EXPECT_EQ(j.at("controller").at("identical"), j.at("controller").at("compared"));
+}
+
+// In lockstep (tools/launch.sh's default for the simulator) the plant waits
+// for the stack's commands: the same stall moves nothing and is no fault
+// (supervisor.stall_check false in the launcher's overlay). The run goes on
+// armed and replays bit-identically; no node fault, no supervisor stop.
+TEST_F(ReplayStack, InLockstepAStalledSafetyProcessIsWaitedForNotHeld) {
+  constexpr int kPort = kLcmPort + 2;
+  const std::string json = run_folder_ + "/waited.json";
+  nlohmann::json j;
+  std::string run;
+  for (int attempt = 1; attempt <= kAttempts; ++attempt) {
+    run = run_folder_ + "/waited" + std::to_string(attempt);
+    ASSERT_EQ(StallSafetyMidRun(run, kPort), 0);
+    const LaunchResult launch =
+        RunLauncher("--no-build --scenario paper --duration " + FormatNumber(kDurationS), kPort,
+                    run, run_folder_ + "/waited_launch" + std::to_string(attempt) + ".out");
+    ASSERT_EQ(launch.exit_code, 0) << LaunchFailure(launch);
+    const int exit_code = Replay(run, "--expect-identical --json " + ShellQuote(json), "waited");
+    j = nlohmann::json::parse(ReadFile(json));
+    ASSERT_EQ(exit_code, 0) << ReadFile(run_folder_ + "/waited.out");
+    if (TotalMissing(j) == 0 && Exists(run + ".stalled")) break;
+    std::printf("[replay] waited attempt %d: lcm-logger lost %ld messages, stalled: %d\n", attempt,
+                TotalMissing(j), Exists(run + ".stalled") ? 1 : 0);
+  }
+  std::printf("%s", ReadFile(run_folder_ + "/waited.out").c_str());
+  ASSERT_TRUE(Exists(run + ".stalled")) << "the safety process was never stopped";
+  const nlohmann::json& s = j.at("safety");
+  EXPECT_TRUE(s.at("node_faults").at("heard").empty()) << s.at("node_faults");
+  EXPECT_EQ(s.at("fallback").at("supervisor_stop"), 0);
+  EXPECT_EQ(s.at("identical"), s.at("compared"));
+  EXPECT_EQ(s.at("fallback").at("identical"), s.at("fallback").at("compared"));
 }
 
 }  // namespace

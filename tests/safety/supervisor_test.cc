@@ -130,6 +130,21 @@ TEST(Supervisor, AStateThatWaitedLongerThanTheLatchIsAStallWhileMoving) {
   EXPECT_EQ(s.InputWaitFault(2'000'000), "");
 }
 
+// Lockstep simulation: the plant waits for the command, so a late read
+// stalls nothing (tools/launch.sh sets stall_check false there).
+TEST(Supervisor, WithoutTheStallCheckAWaitIsNoFault) {
+  SupervisorConfig c = Config(0.0);
+  c.fallback_latch_s = 0.1;
+  c.stall_check = false;
+  Supervisor s(c);
+  s.OnStep(Good(0));
+  ASSERT_TRUE(Do(&s, OperatorCommand::kArm));
+  s.OnStep(Good(1));
+  ASSERT_EQ(s.state(), SupervisorState::kArmed);
+  EXPECT_EQ(s.InputWaitFault(2'000'000), "");
+  EXPECT_EQ(s.state(), SupervisorState::kArmed);
+}
+
 TEST(Supervisor, ALatchOfZeroDoesNotMakeEveryWaitAStall) {
   SupervisorConfig c = Config(0.0);
   c.fallback_latch_s = 0.0;  // every lasting fallback latches at once

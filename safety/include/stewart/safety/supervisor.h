@@ -89,6 +89,13 @@ struct SupervisorConfig {
   /// stand-in for the operator. Never on hardware (tools/launch.sh sets it
   /// in simulation only).
   bool auto_arm = false;
+  /// A state or nominal command read later than fallback_latch_s (wall
+  /// time, at least kMinInputWait_s) after it arrived is a fault while
+  /// moving: the safety process stalled (InputWaitFault). false where the
+  /// plant waits for the stack (lockstep simulation: tools/launch.sh sets it
+  /// there), since nothing moves while it waits and a loaded host would end
+  /// the run in HOLD.
+  bool stall_check = true;
   /// Process heartbeats older than this (wall time, s) are a fault while
   /// armed, and block arming.
   double heartbeat_timeout_s = 1.5;
