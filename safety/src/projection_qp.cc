@@ -22,14 +22,6 @@ using ActiveMatrix = Eigen::Matrix<double, Eigen::Dynamic, 6, 0, 6, 6>;
 using ActiveVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 6, 1>;
 using ActiveGram = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 6, 6>;
 
-// Re-solves the final active set directly so the active constraints hold to
-// rounding, whatever the path the iteration took: x = x0 + N^T mu with
-// N N^T mu = b_N - N x0, through the QR factors of N^T = Q R (so that
-// x - x0 = Q R^-T r and mu = R^-1 R^-T r). Not through the Gram N N^T: two
-// nearly parallel active normals (a position row and a velocity row near a
-// limit, multipliers ~1e7) would square its condition number and leave the
-// constraints violated by ~1e-10 relative. One step of refinement on the
-// residual takes the rest.
 // Householder QR of the 6 x k matrix whose columns are k <= 6 normals, in
 // fixed storage (LAPACK's convention: H_j = I - tau_j v_j v_j^T with
 // v_j(j) = 1, Q = H_0 ... H_{k-1}); the same factors as Eigen's
@@ -164,8 +156,9 @@ void Polish(const ProjectionQpN<MaxRows>& qp, const std::array<int, 6>& active, 
 // The step direction's multipliers for k <= 6 active normals (rows[0..k)):
 // r solves (N N^T) r = N a_p, by a Cholesky factor of the Gram in fixed
 // storage (Eigen's dynamic-size LDLT was 14 % of the worst step's profile).
-// False, with r untouched, when a pivot is not positive and finite (normals
-// dependent to rounding): the caller then takes the pivoted LDLT.
+// False when a pivot is not positive and finite or r is not finite (normals
+// dependent to rounding): r is then meaningless and the caller takes the
+// pivoted LDLT.
 bool SolveActiveGram(const std::array<Vector6d, 6>& rows, int k, const Vector6d& a_p, double r[6]) {
   double l[6][6];
   double y[6];

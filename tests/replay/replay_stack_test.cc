@@ -75,6 +75,14 @@ class ReplayStack : public WithRunFolder<::testing::Test> {
  protected:
   ReplayStack() : WithRunFolder("stewart_replay_stack") {}
 
+  /// A paper run on `port` (more launcher flags: `launch_args`) whose safety
+  /// process is stopped mid-run (StallSafetyMidRun), replayed with
+  /// `replay_args --expect-identical`; run again (up to kAttempts) until the
+  /// stall hit the run and lcm-logger lost nothing. The replay's JSON (null
+  /// after a failure, reported); its report in <root>/<name>.out.
+  nlohmann::json StalledRunReplay(const std::string& name, int port, const std::string& launch_args,
+                                  const std::string& replay_args);
+
   /// stewart_replay on the run; its stdout and stderr go to <root>/<name>.out.
   int Replay(const std::string& run, const std::string& args, const std::string& name) {
     return Shell(ShellQuote(STEWART_REPLAY_PATH) + " " + ShellQuote(run) + " " + args + " >" +
@@ -103,6 +111,42 @@ long TotalMissing(const nlohmann::json& replay) {
   long missing = 0;
   for (const auto& gaps : replay.at("log_gaps")) missing += gaps.at("missing").get<long>();
   return missing;
+}
+
+nlohmann::json ReplayStack::StalledRunReplay(const std::string& name, int port,
+                                             const std::string& launch_args,
+                                             const std::string& replay_args) {
+  const std::string json = run_folder_ + "/" + name + ".json";
+  nlohmann::json j;
+  for (int attempt = 1; attempt <= kAttempts; ++attempt) {
+    const std::string run = run_folder_ + "/" + name + std::to_string(attempt);
+    if (StallSafetyMidRun(run, port) != 0) {
+      ADD_FAILURE() << "the background stall did not start";
+      return nullptr;
+    }
+    const LaunchResult launch = RunLauncher(
+        "--no-build --scenario paper --duration " + FormatNumber(kDurationS) + " " + launch_args,
+        port, run, run_folder_ + "/" + name + "_launch" + std::to_string(attempt) + ".out");
+    if (launch.exit_code != 0) {
+      ADD_FAILURE() << LaunchFailure(launch);
+      return nullptr;
+    }
+    const int exit_code =
+        Replay(run, replay_args + " --expect-identical --json " + ShellQuote(json), name);
+    if (exit_code != 0) {
+      ADD_FAILURE() << ReadFile(run_folder_ + "/" + name + ".out");
+      return nullptr;
+    }
+    j = nlohmann::json::parse(ReadFile(json));
+    const bool stalled = Exists(run + ".stalled");
+    if (TotalMissing(j) == 0 && stalled) return j;
+    // A loaded host may start the stack late enough for the stall to miss
+    // the run; the logger may lose messages (see above).
+    std::printf("[replay] %s attempt %d: lcm-logger lost %ld messages, stalled: %d\n", name.c_str(),
+                attempt, TotalMissing(j), stalled ? 1 : 0);
+  }
+  ADD_FAILURE() << "no complete log of a stalled run in " << kAttempts << " attempts";
+  return nullptr;
 }
 
 TEST_F(ReplayStack, LockstepRunReplaysBitIdentically) {
@@ -250,32 +294,13 @@ TEST_F(ReplayStack, LockstepRunReplaysBitIdentically) {
 // hears the same fault between the same two commands, so the whole run,
 // HOLD included, replays bit-identically.
 TEST_F(ReplayStack, AStalledSafetyProcessHoldsAndReplaysBitIdentically) {
-  constexpr int kPort = kLcmPort + 1;
-  const std::string json = run_folder_ + "/stalled.json";
+  // In lockstep a stall is no fault (supervisor.stall_check false: the
+  // plant waits); turned on here, the supervisor judges it as in real time.
   const std::string stall_check_overlay = run_folder_ + "/stall_check.yaml";
   std::ofstream(stall_check_overlay) << "supervisor:\n  stall_check: true\n";
-  nlohmann::json j;
-  std::string run;
-  for (int attempt = 1; attempt <= kAttempts; ++attempt) {
-    run = run_folder_ + "/stalled" + std::to_string(attempt);
-    ASSERT_EQ(StallSafetyMidRun(run, kPort), 0);
-    // In lockstep a stall is no fault (supervisor.stall_check false: the
-    // plant waits); turned on here, the supervisor judges it as in real time.
-    const LaunchResult launch =
-        RunLauncher("--no-build --scenario paper --duration " + FormatNumber(kDurationS) +
-                        " --overlay " + ShellQuote(stall_check_overlay),
-                    kPort, run, run_folder_ + "/stalled_launch" + std::to_string(attempt) + ".out");
-    ASSERT_EQ(launch.exit_code, 0) << LaunchFailure(launch);
-    const int exit_code =
-        Replay(run, "--controller --expect-identical --json " + ShellQuote(json), "stalled");
-    j = nlohmann::json::parse(ReadFile(json));
-    ASSERT_EQ(exit_code, 0) << ReadFile(run_folder_ + "/stalled.out");
-    // Retried when the logger lost messages (see above), or when the stall
-    // missed the motion (a loaded host started the stack late).
-    if (TotalMissing(j) == 0 && !j.at("safety").at("node_faults").at("heard").empty()) break;
-    std::printf("[replay] stalled attempt %d: lcm-logger lost %ld messages, %zu node faults\n",
-                attempt, TotalMissing(j), j.at("safety").at("node_faults").at("heard").size());
-  }
+  const nlohmann::json j = StalledRunReplay(
+      "stalled", kLcmPort + 1, "--overlay " + ShellQuote(stall_check_overlay), "--controller");
+  ASSERT_FALSE(j.is_null());
   std::printf("%s", ReadFile(run_folder_ + "/stalled.out").c_str());
   const nlohmann::json& s = j.at("safety");
   EXPECT_EQ(s.at("node_faults").at("source"), "recorded");
@@ -300,26 +325,9 @@ TEST_F(ReplayStack, AStalledSafetyProcessHoldsAndReplaysBitIdentically) {
 // (supervisor.stall_check false in the launcher's overlay). The run goes on
 // armed and replays bit-identically; no node fault, no supervisor stop.
 TEST_F(ReplayStack, InLockstepAStalledSafetyProcessIsWaitedForNotHeld) {
-  constexpr int kPort = kLcmPort + 2;
-  const std::string json = run_folder_ + "/waited.json";
-  nlohmann::json j;
-  std::string run;
-  for (int attempt = 1; attempt <= kAttempts; ++attempt) {
-    run = run_folder_ + "/waited" + std::to_string(attempt);
-    ASSERT_EQ(StallSafetyMidRun(run, kPort), 0);
-    const LaunchResult launch =
-        RunLauncher("--no-build --scenario paper --duration " + FormatNumber(kDurationS), kPort,
-                    run, run_folder_ + "/waited_launch" + std::to_string(attempt) + ".out");
-    ASSERT_EQ(launch.exit_code, 0) << LaunchFailure(launch);
-    const int exit_code = Replay(run, "--expect-identical --json " + ShellQuote(json), "waited");
-    j = nlohmann::json::parse(ReadFile(json));
-    ASSERT_EQ(exit_code, 0) << ReadFile(run_folder_ + "/waited.out");
-    if (TotalMissing(j) == 0 && Exists(run + ".stalled")) break;
-    std::printf("[replay] waited attempt %d: lcm-logger lost %ld messages, stalled: %d\n", attempt,
-                TotalMissing(j), Exists(run + ".stalled") ? 1 : 0);
-  }
+  const nlohmann::json j = StalledRunReplay("waited", kLcmPort + 2, "", "");
+  ASSERT_FALSE(j.is_null());
   std::printf("%s", ReadFile(run_folder_ + "/waited.out").c_str());
-  ASSERT_TRUE(Exists(run + ".stalled")) << "the safety process was never stopped";
   const nlohmann::json& s = j.at("safety");
   EXPECT_TRUE(s.at("node_faults").at("heard").empty()) << s.at("node_faults");
   EXPECT_EQ(s.at("fallback").at("supervisor_stop"), 0);
