@@ -51,6 +51,7 @@
 #include <random>
 #include <set>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "stewart/config/config_loader.h"
@@ -226,7 +227,17 @@ class Stack {
     return std::make_unique<test::ChildProcess>(With({ESTIMATOR_PATH}));
   }
   void Start() {
+    // The logger first, and recording before anything publishes: it creates
+    // its log right after joining the group and subscribes right after
+    // that. Started together, plant_sim's first samples went out before the
+    // logger subscribed on a loaded host (a CI run's log began at sensor
+    // seq 7: a gap no fault explains).
     logger = StartLogger(false);
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+    while (!std::filesystem::exists(log_path_) && std::chrono::steady_clock::now() < deadline) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));  // its subscription, after the file
     safety = StartSafety();
     controller = StartController();
     estimator = StartEstimator();
