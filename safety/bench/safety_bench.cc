@@ -210,6 +210,14 @@ void BM_ForceLimitedFullStepBoxActiveOnly(benchmark::State& state) {
     benchmark::DoNotOptimize(filter.Step(x.q, x.qd, x.f_des, &d));
   }
   state.counters["states"] = static_cast<double>(limited.size());
+  // How many of them the un-composed QP answers (the composed answer broke a
+  // barrier's own condition): those solve two QPs.
+  int per_barrier = 0;
+  for (const Sample* x : limited) {
+    filter.Step(x->q, x->qd, x->f_des, &d);
+    if (d.flags & kFlagPerBarrier) ++per_barrier;
+  }
+  state.counters["per_barrier"] = per_barrier;
 }
 BENCHMARK(BM_ForceLimitedFullStepBoxActiveOnly);
 

@@ -18,6 +18,11 @@ constexpr double kDependentTol = 1e-20;  // ||z||^2 vs ||a_p||^2: a_p in span
 template <int MaxRows>
 constexpr int kMaxIterations = std::max(60, 4 * MaxRows);
 
+// std::fmax / std::fmin are calls into libm here (their NaN rules): these
+// are inline, with the same answer where b is never NaN.
+inline double MaxOf(double a, double b) { return a > b ? a : b; }  // b if a is NaN
+inline double MinOf(double a, double b) { return a < b ? a : b; }  // b if a is NaN
+
 using ActiveMatrix = Eigen::Matrix<double, Eigen::Dynamic, 6, 0, 6, 6>;
 using ActiveVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 6, 1>;
 using ActiveGram = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 6, 6>;
@@ -153,40 +158,94 @@ void Polish(const ProjectionQpN<MaxRows>& qp, const std::array<int, 6>& active, 
   for (int j = 0; j < k; ++j) res->mu(active[static_cast<size_t>(j)]) = mu[j];
 }
 
-// The step direction's multipliers for k <= 6 active normals (rows[0..k)):
-// r solves (N N^T) r = N a_p, by a Cholesky factor of the Gram in fixed
-// storage (Eigen's dynamic-size LDLT was 14 % of the worst step's profile).
-// False when a pivot is not positive and finite or r is not finite (normals
-// dependent to rounding): r is then meaningless and the caller takes the
-// pivoted LDLT.
-bool SolveActiveGram(const std::array<Vector6d, 6>& rows, int k, const Vector6d& a_p, double r[6]) {
-  double l[6][6];
-  double y[6];
-  for (int i = 0; i < k; ++i) {
-    for (int j = 0; j <= i; ++j) {
-      double sum = rows[static_cast<size_t>(i)].dot(rows[static_cast<size_t>(j)]);
-      for (int q = 0; q < j; ++q) sum -= l[i][q] * l[j][q];
-      if (i == j) {
-        if (!(sum > 0.0 && sum < HUGE_VAL)) return false;
-        l[i][i] = std::sqrt(sum);
+// The active normals (rows[0..k)) and a Cholesky factor L of their Gram
+// N N^T in fixed storage, kept across the iterations: a normal added at the
+// end extends L by one row from the forward substitution its step direction
+// already did; a dropped one re-orders the rows, and L is factored afresh at
+// the next solve. (Eigen's dynamic-size LDLT, once used for every solve, was
+// 14 % of the worst step's profile.)
+class ActiveNormals {
+ public:
+  int size() const { return k_; }
+  const Vector6d& row(int j) const { return rows_[static_cast<size_t>(j)]; }
+
+  /// r solving (N N^T) r = N a_p; false when a pivot is not positive and
+  /// finite or r is not finite (normals dependent to rounding): r is then
+  /// meaningless and the caller takes the pivoted LDLT.
+  bool Solve(const Vector6d& a_p, double r[6]) {
+    last_solve_valid_ = false;
+    if (!factor_valid_ && !Factor()) return false;
+    for (int i = 0; i < k_; ++i) {  // L y = N a_p
+      double sum = rows_[static_cast<size_t>(i)].dot(a_p);
+      for (int q = 0; q < i; ++q) sum -= l_[i][q] * y_[q];
+      y_[i] = sum / l_[i][i];
+    }
+    for (int i = k_ - 1; i >= 0; --i) {  // L^T r = y
+      double sum = y_[i];
+      for (int q = i + 1; q < k_; ++q) sum -= l_[q][i] * r[q];
+      r[i] = sum / l_[i][i];
+    }
+    for (int i = 0; i < k_; ++i) {
+      if (!std::isfinite(r[i])) return false;
+    }
+    last_solve_valid_ = true;
+    return true;
+  }
+
+  /// Appends a_p, the normal of the last Solve (or any, on an empty set):
+  /// L's new row is that solve's y, its diagonal sqrt(|a_p|^2 - |y|^2).
+  void Append(const Vector6d& a_p) {
+    if (factor_valid_ && (last_solve_valid_ || k_ == 0)) {
+      double d2 = a_p.squaredNorm();
+      for (int q = 0; q < k_; ++q) {
+        l_[k_][q] = y_[q];
+        d2 -= y_[q] * y_[q];
+      }
+      if (d2 > 0.0 && d2 < HUGE_VAL) {
+        l_[k_][k_] = std::sqrt(d2);
       } else {
-        l[i][j] = sum / l[j][j];
+        factor_valid_ = false;
+      }
+    } else {
+      factor_valid_ = false;
+    }
+    rows_[static_cast<size_t>(k_++)] = a_p;
+    last_solve_valid_ = false;
+  }
+
+  /// Removes row j; the last row takes its place.
+  void Remove(int j) {
+    rows_[static_cast<size_t>(j)] = rows_[static_cast<size_t>(k_ - 1)];
+    --k_;
+    factor_valid_ = k_ == 0;  // the empty factor is valid
+    last_solve_valid_ = false;
+  }
+
+ private:
+  bool Factor() {
+    for (int i = 0; i < k_; ++i) {
+      for (int j = 0; j <= i; ++j) {
+        double sum = rows_[static_cast<size_t>(i)].dot(rows_[static_cast<size_t>(j)]);
+        for (int q = 0; q < j; ++q) sum -= l_[i][q] * l_[j][q];
+        if (i == j) {
+          if (!(sum > 0.0 && sum < HUGE_VAL)) return false;
+          l_[i][i] = std::sqrt(sum);
+        } else {
+          l_[i][j] = sum / l_[j][j];
+        }
       }
     }
-    double sum = rows[static_cast<size_t>(i)].dot(a_p);  // L y = N a_p
-    for (int q = 0; q < i; ++q) sum -= l[i][q] * y[q];
-    y[i] = sum / l[i][i];
+    factor_valid_ = true;
+    return true;
   }
-  for (int i = k - 1; i >= 0; --i) {  // L^T r = y
-    double sum = y[i];
-    for (int q = i + 1; q < k; ++q) sum -= l[q][i] * r[q];
-    r[i] = sum / l[i][i];
-  }
-  for (int i = 0; i < k; ++i) {
-    if (!std::isfinite(r[i])) return false;
-  }
-  return true;
-}
+
+  std::array<Vector6d, 6> rows_;
+  double l_[6][6];
+  double y_[6];
+  int k_ = 0;
+  bool factor_valid_ = true;  // the empty factor
+  bool last_solve_valid_ = false;
+};
 
 }  // namespace
 
@@ -199,9 +258,13 @@ ProjectionResultN<MaxRows> SolveProjectionQp(const ProjectionQpN<MaxRows>& qp) {
   std::array<int, 6> active{};
   int num_active = 0;
   std::array<bool, MaxRows> is_active{};
-  // The rows' lengths, once (every iteration scans every inactive row).
-  std::array<double, MaxRows> row_norm{};
-  for (int i = 0; i < qp.m; ++i) row_norm[static_cast<size_t>(i)] = qp.a.row(i).norm();
+  ActiveNormals normals;  // the rows of `active`, in its order
+  // The rows' lengths, once (every iteration scans every inactive row), down
+  // the columns of the column-major rows: vectorised.
+  Eigen::Matrix<double, MaxRows, 1> row_norm;
+  row_norm.head(qp.m) = qp.a.col(0).head(qp.m).cwiseAbs2();
+  for (int c = 1; c < 6; ++c) row_norm.head(qp.m) += qp.a.col(c).head(qp.m).cwiseAbs2();
+  row_norm.head(qp.m) = row_norm.head(qp.m).cwiseSqrt();
 
   for (int iter = 0; iter < kMaxIterations<MaxRows>; ++iter) {
     res.iterations = iter + 1;
@@ -215,7 +278,7 @@ ProjectionResultN<MaxRows> SolveProjectionQp(const ProjectionQpN<MaxRows>& qp) {
     ax.head(qp.m).noalias() = qp.a.topRows(qp.m) * res.x;
     for (int i = 0; i < qp.m; ++i) {
       if (is_active[static_cast<size_t>(i)]) continue;
-      const double norm = row_norm[static_cast<size_t>(i)];
+      const double norm = row_norm(i);
       const double slack = ax(i) - qp.b(i);
       const double tol = kFeasTol * (std::fabs(qp.b(i)) + norm * x_norm);
       if (slack < -tol && slack / norm < worst) {
@@ -231,21 +294,17 @@ ProjectionResultN<MaxRows> SolveProjectionQp(const ProjectionQpN<MaxRows>& qp) {
     const Vector6d a_p = qp.a.row(p).transpose();
     double mu_p = 0.0;
     for (;;) {
-      std::array<Vector6d, 6> rows;
-      for (int j = 0; j < num_active; ++j) {
-        rows[static_cast<size_t>(j)] = qp.a.row(active[static_cast<size_t>(j)]).transpose();
-      }
       double r[6];
       Vector6d z = a_p;
       if (num_active > 0) {
-        if (!SolveActiveGram(rows, num_active, a_p, r)) {
+        if (!normals.Solve(a_p, r)) {
           ActiveMatrix n(num_active, 6);
-          for (int j = 0; j < num_active; ++j) n.row(j) = rows[static_cast<size_t>(j)].transpose();
+          for (int j = 0; j < num_active; ++j) n.row(j) = normals.row(j).transpose();
           const ActiveGram gram = n * n.transpose();
           const ActiveVector r_ldlt = gram.ldlt().solve(n * a_p);
           for (int j = 0; j < num_active; ++j) r[j] = r_ldlt(j);
         }
-        for (int j = 0; j < num_active; ++j) z -= r[j] * rows[static_cast<size_t>(j)];
+        for (int j = 0; j < num_active; ++j) z -= r[j] * normals.row(j);
       }
       const double inf = std::numeric_limits<double>::infinity();
       // Six independent normals span R^6: a seventh is dependent, whatever
@@ -268,11 +327,11 @@ ProjectionResultN<MaxRows> SolveProjectionQp(const ProjectionQpN<MaxRows>& qp) {
         res.status = ProjectionStatus::kInfeasible;
         return res;
       }
-      const double t = std::fmin(t1, t2);
+      const double t = MinOf(t1, t2);  // t2 is never NaN
       if (!dependent) res.x += t * z;
       for (int j = 0; j < num_active; ++j) {
         double& mu = res.mu(active[static_cast<size_t>(j)]);
-        mu = std::fmax(mu - t * r[j], 0.0);
+        mu = MaxOf(mu - t * r[j], 0.0);
       }
       mu_p += t;
       if (t2 < t1) {
@@ -281,11 +340,13 @@ ProjectionResultN<MaxRows> SolveProjectionQp(const ProjectionQpN<MaxRows>& qp) {
         is_active[static_cast<size_t>(k)] = false;
         active[static_cast<size_t>(drop)] = active[static_cast<size_t>(num_active - 1)];
         --num_active;
+        normals.Remove(drop);
         continue;
       }
       res.mu(p) = mu_p;
       is_active[static_cast<size_t>(p)] = true;
       active[static_cast<size_t>(num_active++)] = p;
+      normals.Append(a_p);
       break;
     }
     // Recompute x from the multipliers: keeps rounding from accumulating.

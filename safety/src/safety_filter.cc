@@ -438,7 +438,10 @@ bool SafetyFilter::BuildQp(const Matrix6d& map, const BarrierEvaluation& b, cons
   FilterWorkspace ws;  // its own: leaves the data of the filter's step alone
   ws.metric_map = map;
   ComposeProblem(b, &ws);
-  const bool posable = PoseQp(f_des, ConditionGroups::kAll, &ws);
+  // No factor of M here: y0 = T^-1 F_des by a solve with T itself.
+  Vector6d y0 = f_des;
+  if (metric_ != CorrectionMetric::kForce && !SolvePartialPivot6(map, &y0)) y0.setConstant(NAN);
+  const bool posable = PoseQp(y0, ConditionGroups::kAll, &ws);
   *qp = ws.composed.qp;
   if (rows != nullptr) *rows = ws.composed.rows;
   return posable;
@@ -448,18 +451,22 @@ void SafetyFilter::ComposeProblem(const BarrierEvaluation& b, FilterWorkspace* w
   ws->problem = MakeProblem(constraints_, b, ws->metric_map, metric_);
 }
 
-bool SafetyFilter::PoseQp(const Vector6d& f_des, ConditionGroups groups,
-                          FilterWorkspace* ws) const {
+Vector6d SafetyFilter::MetricCoordinates(const Vector6d& f, const Matrix6d& h,
+                                         const BarrierIntermediates& x) const {
+  if (metric_ == CorrectionMetric::kForce) return f;
+  if (!x.inertia_valid) return Vector6d::Constant(NAN);
+  // T = H^-1 L_M (M = L_M L_M^T): T^-1 f = L_M^-1 H f, a product and a
+  // triangular solve instead of a factorisation of T.
+  return x.inertia.SolveFactorL(h * f);
+}
+
+bool SafetyFilter::PoseQp(const Vector6d& y0, ConditionGroups groups, FilterWorkspace* ws) const {
   const TwoConstraintProblem& problem = ws->problem;
   ProjectionQp& qp = ws->composed.qp;
   QpRows& rows = ws->composed.rows;
   rows = QpRows{};
   qp.m = 0;
-  // y = T^-1 F; y0 = T^-1 F_des (F_des itself for the force metric).
-  qp.x0 = f_des;
-  if (metric_ != CorrectionMetric::kForce && !SolvePartialPivot6(ws->metric_map, &qp.x0)) {
-    qp.x0.setConstant(NAN);
-  }
+  qp.x0 = y0;
   bool posable = true;
   if (problem.has_p) {
     const ConditionRow r = AppendConditionRow(problem.psi_p, problem.g_p, &qp);
@@ -495,12 +502,13 @@ void SafetyFilter::SolveForceLimited(const StepInput& in, FilterWorkspace* ws,
   const QpRows& rows = ws->composed.rows;
   ProjectionResult& r = ws->composed.result;
   r.status = ProjectionStatus::kInfeasible;
-  if (PoseQp(in.f_des, ConditionGroups::kAll, ws)) r = SolveProjectionQp(qp);
+  const Vector6d y0 = MetricCoordinates(in.f_des, in.terms.H, ws->barrier);
+  if (PoseQp(y0, ConditionGroups::kAll, ws)) r = SolveProjectionQp(qp);
   if (r.status != ProjectionStatus::kOptimal) {
     // Keep the position condition and the limits, relax velocity.
     d->infeasible = true;
     r.status = ProjectionStatus::kInfeasible;
-    if (PoseQp(in.f_des, ConditionGroups::kPositionOnly, ws)) r = SolveProjectionQp(qp);
+    if (PoseQp(y0, ConditionGroups::kPositionOnly, ws)) r = SolveProjectionQp(qp);
     if (r.status != ProjectionStatus::kOptimal) {
       ApplySafeStop(in, d);
       return;
@@ -518,7 +526,8 @@ void SafetyFilter::SolveReference(const StepInput& in, FilterWorkspace* ws,
   const ProjectionQp& qp = ws->composed.qp;
   Vector6d& y = ws->composed.result.x;
   y = in.f_des;
-  const bool posable = PoseQp(in.f_des, ConditionGroups::kAll, ws);
+  const bool posable =
+      PoseQp(MetricCoordinates(in.f_des, in.terms.H, ws->barrier), ConditionGroups::kAll, ws);
   if (!posable || reference_->Solve(qp, &y) != ProjectionStatus::kOptimal) {
     // The reference has no answer: the closed form's documented fallback.
     SolveUnlimited(in, *ws, d);

@@ -75,17 +75,7 @@ bool SafetyFilter::PoseUncomposedQp(const StepInput& in, ConditionGroups groups,
   // triangular solves instead of solves with T and 6x6 products.
   Matrix6d l_m;
   if (!force_metric) l_m = ws.barrier.inertia.MatrixL();
-  const auto lower = l_m.triangularView<Eigen::Lower>();
-  // y = T^-1 F; y0 = T^-1 F_des (F_des itself for the force metric), as BuildQp.
-  qp.x0 = in.f_des;
-  if (!force_metric) {
-    if (ws.barrier.inertia_valid) {
-      qp.x0 = terms.H * in.f_des;
-      lower.solveInPlace(qp.x0);
-    } else {
-      qp.x0.setConstant(NAN);
-    }
-  }
+  qp.x0 = MetricCoordinates(in.f_des, terms.H, ws.barrier);
   bool posable = true;
 
   if (c.num_position > 0 && groups != ConditionGroups::kVelocityOnly && !b.outside_position_set) {

@@ -86,6 +86,18 @@ class Cholesky6 {
     return b;
   }
 
+  /// L_M^-1 b for the factor L_M = L D^1/2 of MatrixL: the forward half of
+  /// a solve, without forming L_M.
+  Vector6d SolveFactorL(Vector6d b) const {
+#pragma GCC unroll 6
+    for (int k = 0; k < 6; ++k) {
+#pragma GCC unroll 6
+      for (int i = k + 1; i < 6; ++i) b(i) -= l_(i, k) * b(k);
+    }
+    for (int i = 0; i < 6; ++i) b(i) /= std::sqrt(d_(i));
+    return b;
+  }
+
   /// The Cholesky factor L_M of A = L_M L_M^T (L_M = L D^1/2, zero above the
   /// diagonal): what Eigen's LLT calls matrixL().
   Matrix6d MatrixL() const {

@@ -162,8 +162,13 @@ class SafetyFilter {
   void SolveUnlimited(const StepInput& in, const FilterWorkspace& ws, SafetyDiagnostics* d) const;
   /// ws->problem from the barriers and ws->metric_map.
   void ComposeProblem(const BarrierEvaluation& b, FilterWorkspace* ws) const;
-  /// ws->composed.qp and .rows from ws->problem and ws->metric_map.
-  bool PoseQp(const Vector6d& f_des, ConditionGroups groups, FilterWorkspace* ws) const;
+  /// y = T^-1 f in the metric's coordinates from the factor of M in `x`
+  /// (f itself for the force metric; NaN without a factor).
+  Vector6d MetricCoordinates(const Vector6d& f, const Matrix6d& h,
+                             const BarrierIntermediates& x) const;
+  /// ws->composed.qp and .rows from ws->problem and ws->metric_map; y0 =
+  /// T^-1 F_des (MetricCoordinates, or a solve with T where M has no factor).
+  bool PoseQp(const Vector6d& y0, ConditionGroups groups, FilterWorkspace* ws) const;
   void SolveForceLimited(const StepInput& in, FilterWorkspace* ws, SafetyDiagnostics* d) const;
   void SolveReference(const StepInput& in, FilterWorkspace* ws, SafetyDiagnostics* d) const;
   /// `out` posed from ws.barrier.inertia and ws.metric_map.
