@@ -46,20 +46,29 @@ TwoConstraintProblem MakeProblem(const ConstraintSet& c, const BarrierEvaluation
   return p;
 }
 
-// Solves H X = B in place; false when H is singular or so nearly singular
-// that the solve amplifies B by more than kMaxLegJacobianCondition
-// (||H|| ||X|| / ||B|| <= cond(H)). Costs two norms on the steps that solve.
+// Solves H X = B in place with H's factor, factored by the first solve that
+// needs it; false when H is singular or so nearly singular that the solve
+// amplifies B by more than kMaxLegJacobianCondition (||H|| ||X|| / ||B|| <=
+// cond(H)). Costs two norms on the steps that solve.
 template <int Cols>
-bool SolveWithLegJacobian(const Matrix6d& h, Eigen::Matrix<double, 6, Cols>* b) {
+bool SolveWithLegJacobian(const Matrix6d& h, LegJacobianFactor* factor,
+                          Eigen::Matrix<double, 6, Cols>* b) {
+  if (!factor->computed) {
+    factor->nonsingular = factor->lu.Compute(h);
+    factor->h_norm = h.norm();
+    factor->computed = true;
+  }
+  if (!factor->nonsingular) return false;
   const double rhs_norm = b->norm();
-  if (!SolvePartialPivot6(h, b)) return false;
-  return h.norm() * b->norm() <= kMaxLegJacobianCondition * rhs_norm;
+  factor->lu.SolveInPlace(b);
+  return factor->h_norm * b->norm() <= kMaxLegJacobianCondition * rhs_norm;
 }
 
 // T = H^-1 L_M given the factor of M; false (T NaN) when H is singular.
-bool AccelerationMetricMap(const Matrix6d& h, const Cholesky6& inertia, Matrix6d* map) {
+bool AccelerationMetricMap(const Matrix6d& h, const Cholesky6& inertia, LegJacobianFactor* factor,
+                           Matrix6d* map) {
   *map = inertia.MatrixL();
-  if (SolveWithLegJacobian(h, map)) return true;
+  if (SolveWithLegJacobian(h, factor, map)) return true;
   map->setConstant(NAN);
   return false;
 }
@@ -156,6 +165,7 @@ Vector6d SafetyFilter::StepWithTerms(const DynamicsTerms& terms, const Vector6d&
   d->f_des = f_des;
   d->compute_ns = 0;
   workspace_.leg_jacobian_degenerate = false;
+  workspace_.leg_jacobian.computed = false;
 
   // A finite pose the platform cannot be in (pose_plausibility.h) is as
   // invalid as a NaN: its model terms are numbers without meaning.
@@ -216,7 +226,7 @@ Vector6d SafetyFilter::StepWithTerms(const DynamicsTerms& terms, const Vector6d&
     if (variant_ == SafetyVariant::kQpReference || variant_ == SafetyVariant::kUncomposed ||
         force_limits_) {
       // These pose the QP in y = T^-1 F, so they need T itself.
-      ok = ComputeMetricMap(terms, ws.barrier, &ws.metric_map);
+      ok = ComputeMetricMap(terms, ws.barrier, &ws.leg_jacobian, &ws.metric_map);
       metric_map_ready = ok;
       if (ok && variant_ == SafetyVariant::kQpReference) {
         SolveReference(in, &ws, d);
@@ -245,7 +255,7 @@ Vector6d SafetyFilter::StepWithTerms(const DynamicsTerms& terms, const Vector6d&
     d->mu_p = d->mu_v = 0.0;
     d->mu_force.setZero();
     d->flags = (d->flags & ~(kFlagFallback | kFlagForceLimited)) | kFlagPerBarrier;
-    ok = metric_map_ready || ComputeMetricMap(terms, ws.barrier, &ws.metric_map);
+    ok = metric_map_ready || ComputeMetricMap(terms, ws.barrier, &ws.leg_jacobian, &ws.metric_map);
     if (ok) SolveUncomposed(in, &ws, d);
     ok = ok && d->f_safe.allFinite();
   }
@@ -330,13 +340,14 @@ void SafetyFilter::ApplySafeStop(const StepInput& in, SafetyDiagnostics* d) cons
 Matrix6d SafetyFilter::MetricMap(const DynamicsTerms& terms) const {
   BarrierIntermediates x;
   x.inertia_valid = x.inertia.Compute(terms.M);
+  LegJacobianFactor factor;  // its own: these terms are not the step's
   Matrix6d map;
-  ComputeMetricMap(terms, x, &map);
+  ComputeMetricMap(terms, x, &factor, &map);
   return map;
 }
 
 bool SafetyFilter::ComputeMetricMap(const DynamicsTerms& terms, const BarrierIntermediates& x,
-                                    Matrix6d* map) const {
+                                    LegJacobianFactor* factor, Matrix6d* map) const {
   if (metric_ == CorrectionMetric::kForce) {
     map->setIdentity();
     return true;
@@ -345,7 +356,7 @@ bool SafetyFilter::ComputeMetricMap(const DynamicsTerms& terms, const BarrierInt
     map->setConstant(NAN);
     return false;
   }
-  if (AccelerationMetricMap(terms.H, x.inertia, map)) return true;
+  if (AccelerationMetricMap(terms.H, x.inertia, factor, map)) return true;
   workspace_.leg_jacobian_degenerate = true;
   return false;
 }
@@ -425,7 +436,7 @@ void SafetyFilter::SolveUnlimited(const StepInput& in, const FilterWorkspace& ws
     // F* - F_des = W^-1 (mu_p g_p + mu_v g_v) with W^-1 = H^-1 M H^-T:
     // H (F* - F_des) = mu_v a_c - mu_p s_p M qd, one solve with H.
     Vector6d correction = s.mu_v * x.a_c - (s.mu_p * x.s_p) * x.m_qd;
-    if (!SolveWithLegJacobian(in.terms.H, &correction)) {
+    if (!SolveWithLegJacobian(in.terms.H, &workspace_.leg_jacobian, &correction)) {
       correction.setConstant(NAN);  // the fallback
       workspace_.leg_jacobian_degenerate = true;
     }

@@ -111,53 +111,83 @@ class Cholesky6 {
   Vector6d d_, inv_d_;
 };
 
+/// LU factorisation with partial pivoting of a 6x6 matrix, P A = L U (L unit
+/// lower triangular), as Eigen's PartialPivLU, in fixed storage: one factor
+/// for several solves.
+class PartialPivLu6 {
+ public:
+  /// Factors `a`. Returns false, and leaves the factor unusable, when a
+  /// pivot is zero or not finite (A singular or not finite).
+  bool Compute(const Matrix6d& a) {
+    lu_ = a;
+#pragma GCC unroll 6
+    for (int k = 0; k < 6; ++k) {
+      int p = k;
+      double best = std::fabs(lu_(k, k));
+#pragma GCC unroll 6
+      for (int i = k + 1; i < 6; ++i) {
+        const double v = std::fabs(lu_(i, k));
+        p = v > best ? i : p;
+        best = v > best ? v : best;
+      }
+      if (!(best > 0.0 && best < HUGE_VAL)) return false;  // also rejects NaN
+      swap_(k) = p;
+      // Whole rows, the multipliers of earlier columns too, so that the
+      // solve can apply P first.
+      if (p != k) lu_.row(k).swap(lu_.row(p));
+      inv_pivot_(k) = 1.0 / lu_(k, k);
+#pragma GCC unroll 6
+      for (int i = k + 1; i < 6; ++i) lu_(i, k) *= inv_pivot_(k);
+#pragma GCC unroll 6
+      for (int j = k + 1; j < 6; ++j) {
+#pragma GCC unroll 6
+        for (int i = k + 1; i < 6; ++i) lu_(i, j) -= lu_(i, k) * lu_(k, j);
+      }
+    }
+    return true;
+  }
+
+  /// B := A^-1 B, for one or more right-hand sides at once.
+  template <int Cols>
+  void SolveInPlace(Eigen::Matrix<double, 6, Cols>* b) const {
+    Eigen::Matrix<double, 6, Cols>& x = *b;
+#pragma GCC unroll 6
+    for (int k = 0; k < 6; ++k) {  // P, then L y = P b
+      if (swap_(k) != k) x.row(k).swap(x.row(swap_(k)));
+    }
+#pragma GCC unroll 6
+    for (int k = 0; k < 6; ++k) {
+#pragma GCC unroll 6
+      for (int c = 0; c < Cols; ++c) {
+#pragma GCC unroll 6
+        for (int i = k + 1; i < 6; ++i) x(i, c) -= lu_(i, k) * x(k, c);
+      }
+    }
+#pragma GCC unroll 6
+    for (int k = 5; k >= 0; --k) {  // U x = y
+#pragma GCC unroll 6
+      for (int c = 0; c < Cols; ++c) {
+        x(k, c) *= inv_pivot_(k);
+#pragma GCC unroll 6
+        for (int i = 0; i < k; ++i) x(i, c) -= lu_(i, k) * x(k, c);
+      }
+    }
+  }
+
+ private:
+  Matrix6d lu_;  // L strictly below the diagonal, U on and above it
+  Vector6d inv_pivot_;
+  Eigen::Matrix<int, 6, 1> swap_;  // row k was swapped with row swap_(k) >= k
+};
+
 /// Solves A X = B in place (B becomes X) by Gaussian elimination with partial
-/// pivoting, as Eigen's PartialPivLU. Returns false when a pivot is zero or
-/// not finite (A singular or not finite); B is then unusable.
+/// pivoting (PartialPivLu6). Returns false when a pivot is zero or not finite
+/// (A singular or not finite); B is then unusable.
 template <int Cols>
-bool SolvePartialPivot6(Matrix6d a, Eigen::Matrix<double, 6, Cols>* b) {
-  Eigen::Matrix<double, 6, Cols>& x = *b;
-  Vector6d inv_pivot;
-#pragma GCC unroll 6
-  for (int k = 0; k < 6; ++k) {
-    int p = k;
-    double best = std::fabs(a(k, k));
-#pragma GCC unroll 6
-    for (int i = k + 1; i < 6; ++i) {
-      const double v = std::fabs(a(i, k));
-      p = v > best ? i : p;
-      best = v > best ? v : best;
-    }
-    if (!(best > 0.0 && best < HUGE_VAL)) return false;  // also rejects NaN
-    if (p != k) {
-#pragma GCC unroll 6
-      for (int j = k; j < 6; ++j) std::swap(a(k, j), a(p, j));
-#pragma GCC unroll 6
-      for (int c = 0; c < Cols; ++c) std::swap(x(k, c), x(p, c));
-    }
-    inv_pivot(k) = 1.0 / a(k, k);
-#pragma GCC unroll 6
-    for (int i = k + 1; i < 6; ++i) a(i, k) *= inv_pivot(k);
-#pragma GCC unroll 6
-    for (int j = k + 1; j < 6; ++j) {
-#pragma GCC unroll 6
-      for (int i = k + 1; i < 6; ++i) a(i, j) -= a(i, k) * a(k, j);
-    }
-#pragma GCC unroll 6
-    for (int c = 0; c < Cols; ++c) {
-#pragma GCC unroll 6
-      for (int i = k + 1; i < 6; ++i) x(i, c) -= a(i, k) * x(k, c);
-    }
-  }
-#pragma GCC unroll 6
-  for (int k = 5; k >= 0; --k) {  // U x = y
-#pragma GCC unroll 6
-    for (int c = 0; c < Cols; ++c) {
-      x(k, c) *= inv_pivot(k);
-#pragma GCC unroll 6
-      for (int i = 0; i < k; ++i) x(i, c) -= a(i, k) * x(k, c);
-    }
-  }
+bool SolvePartialPivot6(const Matrix6d& a, Eigen::Matrix<double, 6, Cols>* b) {
+  PartialPivLu6 lu;
+  if (!lu.Compute(a)) return false;
+  lu.SolveInPlace(b);
   return true;
 }
 

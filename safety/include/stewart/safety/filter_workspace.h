@@ -6,6 +6,7 @@
 // the QPs as posed, their solutions). Fixed-size storage only, so a step
 // allocates nothing; nothing in it carries over from one step to the next.
 #include "stewart/model/dynamics.h"
+#include "stewart/model/linear_algebra6.h"
 #include "stewart/safety/barriers.h"
 #include "stewart/safety/projection_qp.h"
 #include "stewart/safety/two_constraint_qp.h"
@@ -35,6 +36,15 @@ struct PosedQp {
 using ComposedQpData = PosedQp<kMaxQpRows, QpRows>;
 using UncomposedQpData = PosedQp<kMaxUncomposedQpRows, UncomposedQpRows>;
 
+/// H's LU factor for a step's solves with H (the closed form's correction,
+/// the metric map T = H^-1 L_M): factored at the first of them.
+struct LegJacobianFactor {
+  PartialPivLu6 lu;
+  double h_norm = 0.0;  ///< ||H||_F, for the condition check of each solve
+  bool computed = false;
+  bool nonsingular = false;
+};
+
 // On a cache line of its own, so that which lines a step touches does not
 // depend on where the filter holding it sits.
 struct alignas(64) FilterWorkspace {
@@ -46,6 +56,7 @@ struct alignas(64) FilterWorkspace {
   UncomposedQpData uncomposed;   ///< variant uncomposed: every row, or the position rows
   UncomposedQpData
       velocity_alone;  ///< its unlimited fallback: the velocity rows, from the position rows' point
+  LegJacobianFactor leg_jacobian;  ///< reset by each step
   /// A solve with H this step met H singular or nearly so
   /// (kMaxLegJacobianCondition): the pose is a singular configuration.
   bool leg_jacobian_degenerate = false;

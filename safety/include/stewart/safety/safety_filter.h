@@ -158,7 +158,7 @@ class SafetyFilter {
   /// The safe stop as the answer of a step whose QP has no solution.
   void ApplySafeStop(const StepInput& in, SafetyDiagnostics* d) const;
   bool ComputeMetricMap(const DynamicsTerms& terms, const BarrierIntermediates& x,
-                        Matrix6d* map) const;
+                        LegJacobianFactor* factor, Matrix6d* map) const;
   void SolveUnlimited(const StepInput& in, const FilterWorkspace& ws, SafetyDiagnostics* d) const;
   /// ws->problem from the barriers and ws->metric_map.
   void ComposeProblem(const BarrierEvaluation& b, FilterWorkspace* ws) const;
