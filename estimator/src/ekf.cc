@@ -96,18 +96,45 @@ EulerAngleTrig ShiftEulerAngleTrig(const EulerAngleTrig& from, const Vector3d& d
 }
 
 // P -= G G^T on the lower block triangle (blocks of rows and columns [0, 6),
-// [6, 12), [12, 18), [18, 24): whole SIMD packets), the upper blocks as the
-// mirror. Inside a diagonal block an entry and its mirror are the same sum of
-// the same products in the same order, so P stays symmetric to the last bit.
+// [6, 12), [12, 18), [18, 24)), the upper blocks as the mirror. Inside a
+// diagonal block an entry and its mirror are the same sum of the same
+// products in the same order, so P stays symmetric to the last bit.
 template <int Start, int End, int M>
 void SubtractGramBlock(const Eigen::Matrix<double, kEkfPaddedSize, M>& g,
                        Eigen::Matrix<double, kEkfPaddedSize, kEkfPaddedSize>* p) {
-  constexpr int kRows = kEkfPaddedSize - Start;
+  // Rows from the 4-aligned row at or above the block (whole, aligned AVX
+  // packets; 18 or 6 rows from row 6 or 18 would be 2-wide): the extra rows
+  // lie in the upper block above, which the mirror overwrites.
+  constexpr int kFirst = Start / 4 * 4;
+  constexpr int kRows = kEkfPaddedSize - kFirst;
   for (int j = Start; j < End; ++j) {
     Eigen::Matrix<double, kRows, 1> col = p->col(j).template tail<kRows>();
     for (int k = 0; k < M; ++k) col -= g(j, k) * g.col(k).template tail<kRows>();
     p->col(j).template tail<kRows>() = col;
   }
+}
+
+// Upper triangle := lower triangle, by 6x6 blocks with fixed bounds (fully
+// unrolled; the triangular double loop with variable bounds over 276 entries
+// was a fifth of the prediction).
+template <int N>
+void MirrorLowerTriangle(Eigen::Matrix<double, N, N>* p) {
+  static_assert(N % 6 == 0, "whole 6x6 blocks");
+  for (int b = 0; b < N; b += 6) {
+#pragma GCC unroll 6
+    for (int j = 1; j < 6; ++j) {
+#pragma GCC unroll 6
+      for (int i = 0; i < j; ++i) (*p)(b + i, b + j) = (*p)(b + j, b + i);
+    }
+  }
+  p->template block<6, N - 6>(0, 6) = p->template block<N - 6, 6>(6, 0).transpose();
+  if constexpr (N > 12) {
+    p->template block<6, N - 12>(6, 12) = p->template block<N - 12, 6>(12, 6).transpose();
+  }
+  if constexpr (N > 18) {
+    p->template block<6, N - 18>(12, 18) = p->template block<N - 18, 6>(18, 12).transpose();
+  }
+  static_assert(N <= 24, "blocks beyond the fourth are not mirrored");
 }
 
 template <int M>
@@ -350,10 +377,7 @@ void Ekf::Predict(double dt_s, int64_t utime, const EulerAngleTrig& trig, bool d
     P_.middleRows<6>(kEkfQ) += dt_s * rows_v;
     P_.leftCols<6>() += dt_s * P_.middleCols<6>(kEkfQd);
   }
-  // Upper triangle := lower triangle.
-  for (int j = 1; j < kEkfStateSize; ++j) {
-    for (int i = 0; i < j; ++i) P_(i, j) = P_(j, i);
-  }
+  MirrorLowerTriangle(&P_);
   for (int i = 0; i < 3; ++i) {
     AddWhiteAcceleration(i, sigma_lin, dt_s, &P_);
     AddWhiteAcceleration(i + 3, sigma_ang, dt_s, &P_);

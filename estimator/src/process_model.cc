@@ -188,15 +188,20 @@ void DynamicsAccelerationJacobians(const PlatformParams& params, double friction
     m_inv->setConstant(NAN);
     return;
   }
-  *qdd = inertia.Solve<1>(H * force + disturbance_n - terms.C_qd - terms.G);
-  Rhs6<18> rhs;
+  // 18 columns of derivatives, qdd's right-hand side and a zero column: 20
+  // row-major columns are five whole AVX packets per row, where 18 or 19
+  // would make Eigen fall back to 2-wide packets for the whole solve.
+  Rhs6<20> rhs;
   rhs.leftCols<6>() = numerator;
   rhs.middleCols<6>(6).noalias() = -friction_nspm * H.lazyProduct(H.transpose());
-  rhs.rightCols<6>().setIdentity();
-  inertia.SolveInPlace<18>(&rhs);
+  rhs.middleCols<6>(12).setIdentity();
+  rhs.col(18) = H * force + disturbance_n - terms.C_qd - terms.G;
+  rhs.col(19).setZero();
+  inertia.SolveInPlace<20>(&rhs);
+  *qdd = rhs.col(18);
   *dqdd_dq = rhs.leftCols<6>();
   *dqdd_dqd = rhs.middleCols<6>(6);
-  *m_inv = rhs.rightCols<6>();
+  *m_inv = rhs.middleCols<6>(12);
 }
 
 }  // namespace stewart
