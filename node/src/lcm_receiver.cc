@@ -156,8 +156,17 @@ LcmReceiver::LcmReceiver(const std::string& url) : datagram_(kMaxDatagramBytes) 
   if (setsockopt(fd_, SOL_SOCKET, SO_REUSEADDR, &one, sizeof(one)) != 0) fail("SO_REUSEADDR");
   // Arrival times from the kernel (recv_utime), as lcm::LCM takes them.
   setsockopt(fd_, SOL_SOCKET, SO_TIMESTAMP, &one, sizeof(one));
+  // How many datagrams the kernel dropped for want of buffer, on each read.
+  setsockopt(fd_, SOL_SOCKET, SO_RXQ_OVFL, &one, sizeof(one));
   const int buf = address.recv_buf_size > 0 ? address.recv_buf_size : kDefaultRecvBufBytes;
   setsockopt(fd_, SOL_SOCKET, SO_RCVBUF, &buf, sizeof(buf));  // capped by rmem_max; best effort
+  int granted = 0;
+  socklen_t granted_size = sizeof(granted);
+  if (getsockopt(fd_, SOL_SOCKET, SO_RCVBUF, &granted, &granted_size) == 0 && granted / 2 < buf) {
+    // Above net.core.rmem_max: a process with CAP_NET_ADMIN may still have
+    // it (the kernel reports twice the size it was given).
+    setsockopt(fd_, SOL_SOCKET, SO_RCVBUFFORCE, &buf, sizeof(buf));
+  }
   sockaddr_in bind_address{};
   bind_address.sin_family = AF_INET;
   bind_address.sin_addr.s_addr = htonl(INADDR_ANY);
@@ -226,7 +235,7 @@ int LcmReceiver::HandleTimeoutUs(int64_t timeout_us) {
   for (int read = 0; read < kMaxDatagramsPerCall; ++read) {
     sockaddr_in from{};
     iovec vec{datagram_.data(), datagram_.size()};
-    alignas(cmsghdr) char control[CMSG_SPACE(sizeof(timeval))];
+    alignas(cmsghdr) char control[CMSG_SPACE(sizeof(timeval)) + CMSG_SPACE(sizeof(uint32_t))];
     msghdr msg{};
     msg.msg_name = &from;
     msg.msg_namelen = sizeof(from);
@@ -247,6 +256,10 @@ int LcmReceiver::HandleTimeoutUs(int64_t timeout_us) {
         timeval tv{};
         std::memcpy(&tv, CMSG_DATA(c), sizeof(tv));
         recv_utime = int64_t{tv.tv_sec} * 1000000 + tv.tv_usec;
+      } else if (c->cmsg_level == SOL_SOCKET && c->cmsg_type == SO_RXQ_OVFL) {
+        uint32_t dropped = 0;
+        std::memcpy(&dropped, CMSG_DATA(c), sizeof(dropped));
+        counters_.kernel_drops = dropped;
       }
     }
     if (recv_utime < 0) recv_utime = ReceiveClockUs();

@@ -12,6 +12,7 @@ void ReportReceiverCounters(const LcmReceiver& receiver, HealthReporter* health)
   health->SetCounter("rx_decode_fail", receiver.counters().decode_failures);
   health->SetCounter("rx_incomplete", receiver.counters().incomplete_fragmented);
   health->SetCounter("rx_orphan_fragments", receiver.counters().orphan_fragments);
+  health->SetCounter("rx_kernel_drops", receiver.counters().kernel_drops);
 }
 
 ExitCode RunNodeLoop(const std::string& name, lcm::LCM* lcm, LcmReceiver* receiver,

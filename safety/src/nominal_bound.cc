@@ -18,9 +18,9 @@ Vector6d NominalAccelerationBound(double sample_period_s, double velocity_step_m
 }
 
 double BoundNominal(const DynamicsTerms& terms, const Cholesky6& inertia,
-                    const Vector6d& leg_speed_mps, double leg_friction_nspm,
-                    const Vector6d& disturbance_n, const Vector6d& max_accel, const Vector6d& f_des,
-                    Vector6d* f_bounded) {
+                    LegJacobianFactor* h_factor, const Vector6d& leg_speed_mps,
+                    double leg_friction_nspm, const Vector6d& disturbance_n,
+                    const Vector6d& max_accel, const Vector6d& f_des, Vector6d* f_bounded) {
   *f_bounded = f_des;
   const Vector6d friction_n = LegViscousFriction(leg_friction_nspm, leg_speed_mps);
   const Vector6d qdd_des =
@@ -32,8 +32,10 @@ double BoundNominal(const DynamicsTerms& terms, const Cholesky6& inertia,
     if (magnitude > max_accel(j)) scale = std::min(scale, max_accel(j) / magnitude);
   }
   if (scale == 1.0) return 1.0;
-  const Vector6d f_zero_accel =
-      InverseDynamics(terms, Vector6d::Zero(), disturbance_n) - friction_n;
+  // InverseDynamics(terms, 0, d) with the step's factor of H: H^-1 (C qd + G - d).
+  Vector6d f_zero_accel = terms.C_qd + terms.G - disturbance_n;
+  if (!h_factor->Solve(terms.H, &f_zero_accel)) return 0.0;
+  f_zero_accel -= friction_n;
   if (!f_zero_accel.allFinite()) return 0.0;
   *f_bounded = f_zero_accel + scale * (f_des - f_zero_accel);
   return scale;

@@ -53,21 +53,15 @@ TwoConstraintProblem MakeProblem(const ConstraintSet& c, const BarrierEvaluation
 template <int Cols>
 bool SolveWithLegJacobian(const Matrix6d& h, LegJacobianFactor* factor,
                           Eigen::Matrix<double, 6, Cols>* b) {
-  if (!factor->computed) {
-    factor->nonsingular = factor->lu.Compute(h);
-    factor->h_norm = h.norm();
-    factor->computed = true;
-  }
-  if (!factor->nonsingular) return false;
   const double rhs_norm = b->norm();
-  factor->lu.SolveInPlace(b);
-  return factor->h_norm * b->norm() <= kMaxLegJacobianCondition * rhs_norm;
+  if (!factor->Solve(h, b)) return false;
+  return factor->h_norm() * b->norm() <= kMaxLegJacobianCondition * rhs_norm;
 }
 
-// T = H^-1 L_M given the factor of M; false (T NaN) when H is singular.
-bool AccelerationMetricMap(const Matrix6d& h, const Cholesky6& inertia, LegJacobianFactor* factor,
+// T = H^-1 L_M given L_M; false (T NaN) when H is singular.
+bool AccelerationMetricMap(const Matrix6d& h, const Matrix6d& l_m, LegJacobianFactor* factor,
                            Matrix6d* map) {
-  *map = inertia.MatrixL();
+  *map = l_m;
   if (SolveWithLegJacobian(h, factor, map)) return true;
   map->setConstant(NAN);
   return false;
@@ -165,7 +159,9 @@ Vector6d SafetyFilter::StepWithTerms(const DynamicsTerms& terms, const Vector6d&
   d->f_des = f_des;
   d->compute_ns = 0;
   workspace_.leg_jacobian_degenerate = false;
-  workspace_.leg_jacobian.computed = false;
+  workspace_.leg_jacobian.Reset();
+  workspace_.inertia_factor_l_ready = false;
+  workspace_.y_des_ready = false;
 
   // A finite pose the platform cannot be in (pose_plausibility.h) is as
   // invalid as a NaN: its model terms are numbers without meaning.
@@ -189,11 +185,11 @@ Vector6d SafetyFilter::StepWithTerms(const DynamicsTerms& terms, const Vector6d&
   f_nominal = f_des;
   if (ok) PrepareBarrierIntermediates(terms, qd, &ws.barrier);
   if (ok && bound_nominal_) {
-    const double scale =
-        ws.barrier.inertia_valid
-            ? BoundNominal(terms, ws.barrier.inertia, ws.barrier.leg_rate, leg_friction_nspm_,
-                           held_disturbance, nominal_max_accel_, f_des, &f_nominal)
-            : 0.0;
+    const double scale = ws.barrier.inertia_valid
+                             ? BoundNominal(terms, ws.barrier.inertia, &ws.leg_jacobian,
+                                            ws.barrier.leg_rate, leg_friction_nspm_,
+                                            held_disturbance, nominal_max_accel_, f_des, &f_nominal)
+                             : 0.0;
     ok = scale > 0.0;
     if (scale < 1.0) {
       d->nominal_scale = scale;
@@ -226,8 +222,10 @@ Vector6d SafetyFilter::StepWithTerms(const DynamicsTerms& terms, const Vector6d&
     if (variant_ == SafetyVariant::kQpReference || variant_ == SafetyVariant::kUncomposed ||
         force_limits_) {
       // These pose the QP in y = T^-1 F, so they need T itself.
-      ok = ComputeMetricMap(terms, ws.barrier, &ws.leg_jacobian, &ws.metric_map);
+      ok = ComputeMetricMap(terms, ws.barrier, &ws.leg_jacobian, &ws.inertia_factor_l,
+                            &ws.metric_map);
       metric_map_ready = ok;
+      ws.inertia_factor_l_ready = ok && metric_ != CorrectionMetric::kForce;
       if (ok && variant_ == SafetyVariant::kQpReference) {
         SolveReference(in, &ws, d);
       } else if (ok && variant_ == SafetyVariant::kUncomposed) {
@@ -255,7 +253,11 @@ Vector6d SafetyFilter::StepWithTerms(const DynamicsTerms& terms, const Vector6d&
     d->mu_p = d->mu_v = 0.0;
     d->mu_force.setZero();
     d->flags = (d->flags & ~(kFlagFallback | kFlagForceLimited)) | kFlagPerBarrier;
-    ok = metric_map_ready || ComputeMetricMap(terms, ws.barrier, &ws.leg_jacobian, &ws.metric_map);
+    if (!metric_map_ready) {
+      ok = ComputeMetricMap(terms, ws.barrier, &ws.leg_jacobian, &ws.inertia_factor_l,
+                            &ws.metric_map);
+      ws.inertia_factor_l_ready = ok && metric_ != CorrectionMetric::kForce;
+    }
     if (ok) SolveUncomposed(in, &ws, d);
     ok = ok && d->f_safe.allFinite();
   }
@@ -341,13 +343,13 @@ Matrix6d SafetyFilter::MetricMap(const DynamicsTerms& terms) const {
   BarrierIntermediates x;
   x.inertia_valid = x.inertia.Compute(terms.M);
   LegJacobianFactor factor;  // its own: these terms are not the step's
-  Matrix6d map;
-  ComputeMetricMap(terms, x, &factor, &map);
+  Matrix6d l_m, map;
+  ComputeMetricMap(terms, x, &factor, &l_m, &map);
   return map;
 }
 
 bool SafetyFilter::ComputeMetricMap(const DynamicsTerms& terms, const BarrierIntermediates& x,
-                                    LegJacobianFactor* factor, Matrix6d* map) const {
+                                    LegJacobianFactor* factor, Matrix6d* l_m, Matrix6d* map) const {
   if (metric_ == CorrectionMetric::kForce) {
     map->setIdentity();
     return true;
@@ -356,7 +358,8 @@ bool SafetyFilter::ComputeMetricMap(const DynamicsTerms& terms, const BarrierInt
     map->setConstant(NAN);
     return false;
   }
-  if (AccelerationMetricMap(terms.H, x.inertia, factor, map)) return true;
+  *l_m = x.inertia.MatrixL();
+  if (AccelerationMetricMap(terms.H, *l_m, factor, map)) return true;
   workspace_.leg_jacobian_degenerate = true;
   return false;
 }
@@ -514,6 +517,9 @@ void SafetyFilter::SolveForceLimited(const StepInput& in, FilterWorkspace* ws,
   ProjectionResult& r = ws->composed.result;
   r.status = ProjectionStatus::kInfeasible;
   const Vector6d y0 = MetricCoordinates(in.f_des, in.terms.H, ws->barrier);
+  ws->y_des = y0;  // the un-composed QP that may replace this answer poses the same y0
+  ws->y_des_of_n = in.f_des;
+  ws->y_des_ready = true;
   if (PoseQp(y0, ConditionGroups::kAll, ws)) r = SolveProjectionQp(qp);
   if (r.status != ProjectionStatus::kOptimal) {
     // Keep the position condition and the limits, relax velocity.

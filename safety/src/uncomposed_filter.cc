@@ -74,8 +74,12 @@ bool SafetyFilter::PoseUncomposedQp(const StepInput& in, ConditionGroups groups,
   //   T^T H^T M^-1 e_j = L_M^T M^-1 e_j = L_M^-1 e_j   (velocity rows),
   // triangular solves instead of solves with T and 6x6 products.
   Matrix6d l_m;
-  if (!force_metric) l_m = ws.barrier.inertia.MatrixL();
-  qp.x0 = MetricCoordinates(in.f_des, terms.H, ws.barrier);
+  if (!force_metric) {
+    l_m = ws.inertia_factor_l_ready ? ws.inertia_factor_l : ws.barrier.inertia.MatrixL();
+  }
+  qp.x0 = ws.y_des_ready && ws.y_des_of_n == in.f_des
+              ? ws.y_des
+              : MetricCoordinates(in.f_des, terms.H, ws.barrier);
   bool posable = true;
 
   if (c.num_position > 0 && groups != ConditionGroups::kVelocityOnly && !b.outside_position_set) {

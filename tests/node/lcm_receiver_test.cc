@@ -1,7 +1,7 @@
 // The nodes' LCM receiver: URL parsing, the kernel channel filter on a real
 // socket, and end to end against lcm::LCM publishing short and fragmented
-// messages, with hostile datagrams in between. Private LCM ports 7801-7804
-// and 8001.
+// messages, with hostile datagrams in between. Private LCM ports 7800-7807,
+// 7889 and 8001.
 #include "stewart/node/lcm_receiver.h"
 
 #include <arpa/inet.h>
@@ -310,6 +310,34 @@ TEST(LcmReceiver, SubscribeAllTakesEveryChannelWithKernelArrivalTimes) {
     EXPECT_GE(t, before - 1000);
     EXPECT_LE(t, after + 1000);  // not the read 50 ms later
   }
+}
+
+// A receiver that does not read while its socket buffer overflows says how
+// many datagrams the kernel dropped (SO_RXQ_OVFL): a recorder reports the
+// loss instead of a log silently missing them.
+TEST(LcmReceiver, CountsTheDatagramsTheKernelDroppedForAFullBuffer) {
+  // recv_buf_size=1: the kernel's minimum buffer, a few datagrams.
+  const std::string url = PrivateLcmUrl(7807) + "&recv_buf_size=1";
+  LcmReceiver receiver(url);
+  int received = 0;
+  receiver.SubscribeAll([&](const lcm::ReceiveBuffer&, const std::string&) { ++received; });
+  auto lcm = MakeLcm(PrivateLcmUrl(7807));
+  force_command_t command{};
+  constexpr int kSent = 500;
+  for (int i = 0; i < kSent; ++i) lcm->publish("A", &command);
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  while (receiver.HandleTimeout(50) > 0) {
+  }
+  // The kernel stamps each datagram with the drops before it: the count
+  // arrives with the first datagram queued after the loss.
+  lcm->publish("A", &command);
+  while (receiver.HandleTimeout(50) > 0) {
+  }
+  EXPECT_LT(received, kSent);
+  EXPECT_GT(receiver.counters().kernel_drops, 0);
+  EXPECT_EQ(received + receiver.counters().kernel_drops, kSent + 1);
+  std::printf("[receiver] %d of %d received, %lld dropped by the kernel\n", received, kSent,
+              static_cast<long long>(receiver.counters().kernel_drops));
 }
 
 // Raw datagrams to the bus, as a broken or hostile sender would send them.

@@ -190,7 +190,9 @@ TEST(NominalBound, ScalesTheModelAccelerationKeepingItsDirection) {
     Vector6d f_bounded;
     Cholesky6 inertia;
     ASSERT_TRUE(inertia.Compute(t.M));
-    const double s = BoundNominal(t, inertia, leg_rate, 3.0, d, max_accel, f_des, &f_bounded);
+    LegJacobianFactor h_factor;
+    const double s =
+        BoundNominal(t, inertia, &h_factor, leg_rate, 3.0, d, max_accel, f_des, &f_bounded);
     ASSERT_GT(s, 0.0);
     ASSERT_LT(s, 1.0);  // 200 N on a 0.6 kg platform is far beyond 1 m/s^2
     const Vector6d friction = LegViscousFriction(3.0, leg_rate);

@@ -195,7 +195,9 @@ class Stack {
   }
   /// The logger on the stack's URL; `append` continues the log (a restart).
   std::unique_ptr<test::ChildProcess> StartLogger(bool append) const {
-    std::vector<std::string> argv = {LOGGER_PATH, "--lcm-url=" + url_ + "&recv_buf_size=4194304"};
+    // 32 MB: a stopped process that resumes replays its backlog as a burst of
+    // thousands of messages; 4 MB overflowed once under CI load (4 samples).
+    std::vector<std::string> argv = {LOGGER_PATH, "--lcm-url=" + url_ + "&recv_buf_size=33554432"};
     argv.push_back(append ? "--append" : "-f");
     argv.push_back(log_path_);
     return std::make_unique<test::ChildProcess>(argv);

@@ -163,10 +163,20 @@ int main(int argc, char** argv) {
                append && exists ? " (continued)" : "");
   const auto flush_every = std::chrono::duration<double>(flush_s);
   auto last_flush = std::chrono::steady_clock::now();
+  int64_t drops_reported = 0;
   while (!stewart::StopRequested()) {
     if (receiver->HandleTimeout(100) < 0) {
       spdlog::error("stewart_logger: receive failed");
       break;
+    }
+    const int64_t drops = receiver->counters().kernel_drops;
+    if (drops > drops_reported) {
+      // The log misses these datagrams: say so when it happens, not only at the end.
+      spdlog::warn(
+          "stewart_logger: the kernel dropped {} datagrams so far (socket buffer full: raise "
+          "recv_buf_size on the URL and net.core.rmem_max)",
+          drops);
+      drops_reported = drops;
     }
     const auto now = std::chrono::steady_clock::now();
     if (now - last_flush >= flush_every) {
@@ -181,7 +191,8 @@ int main(int argc, char** argv) {
   const stewart::LcmReceiverCounters& c = receiver->counters();
   spdlog::info(
       "stewart_logger: {} messages written, {} failed ({} datagrams read, {} not LCM, "
-      "{} fragmented messages incomplete)",
-      recorder.written(), recorder.failed(), c.datagrams, c.bad_datagrams, c.incomplete_fragmented);
+      "{} fragmented messages incomplete, {} dropped by the kernel)",
+      recorder.written(), recorder.failed(), c.datagrams, c.bad_datagrams, c.incomplete_fragmented,
+      c.kernel_drops);
   return recorder.failed() == 0 ? 0 : 1;
 }

@@ -6,8 +6,8 @@
 // the QPs as posed, their solutions). Fixed-size storage only, so a step
 // allocates nothing; nothing in it carries over from one step to the next.
 #include "stewart/model/dynamics.h"
-#include "stewart/model/linear_algebra6.h"
 #include "stewart/safety/barriers.h"
+#include "stewart/safety/leg_jacobian_factor.h"
 #include "stewart/safety/projection_qp.h"
 #include "stewart/safety/two_constraint_qp.h"
 #include "stewart/safety/uncomposed_qp.h"
@@ -36,15 +36,6 @@ struct PosedQp {
 using ComposedQpData = PosedQp<kMaxQpRows, QpRows>;
 using UncomposedQpData = PosedQp<kMaxUncomposedQpRows, UncomposedQpRows>;
 
-/// H's LU factor for a step's solves with H (the closed form's correction,
-/// the metric map T = H^-1 L_M): factored at the first of them.
-struct LegJacobianFactor {
-  PartialPivLu6 lu;
-  double h_norm = 0.0;  ///< ||H||_F, for the condition check of each solve
-  bool computed = false;
-  bool nonsingular = false;
-};
-
 // On a cache line of its own, so that which lines a step touches does not
 // depend on where the filter holding it sits.
 struct alignas(64) FilterWorkspace {
@@ -57,6 +48,12 @@ struct alignas(64) FilterWorkspace {
   UncomposedQpData
       velocity_alone;  ///< its unlimited fallback: the velocity rows, from the position rows' point
   LegJacobianFactor leg_jacobian;  ///< reset by each step
+  /// L_M (M = L_M L_M^T) as the metric map's computation left it this step.
+  Matrix6d inertia_factor_l;
+  bool inertia_factor_l_ready = false;  ///< reset by each step
+  /// y = T^-1 F of the force-limited posing, for F = y_des_of_n.
+  Vector6d y_des, y_des_of_n;
+  bool y_des_ready = false;  ///< reset by each step
   /// A solve with H this step met H singular or nearly so
   /// (kMaxLegJacobianCondition): the pose is a singular configuration.
   bool leg_jacobian_degenerate = false;

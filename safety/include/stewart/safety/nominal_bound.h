@@ -20,6 +20,7 @@
 // safety.per_period_angular_step_radps (Euler angles; rad/s).
 #include "stewart/model/dynamics.h"
 #include "stewart/model/linear_algebra6.h"
+#include "stewart/safety/leg_jacobian_factor.h"
 
 namespace stewart::safety {
 
@@ -31,15 +32,16 @@ Vector6d NominalAccelerationBound(double sample_period_s, double velocity_step_m
 /// Scales f_des (N, per leg) towards the zero-acceleration force at the
 /// model terms `terms` (at q, qd) so that the model acceleration obeys
 /// |qdd_j| <= max_accel_j; `inertia` the factor of terms.M (computed by the
-/// caller, who needs it anyway), leg_speed_mps = H^T qd and
+/// caller, who needs it anyway), `h_factor` the step's factor of terms.H
+/// (factored here if no solve of the step has yet), leg_speed_mps = H^T qd and
 /// leg_friction_nspm the filter's leg friction; disturbance_n the estimated
 /// model error d (N, N m). Returns the scale s in (0, 1] (1: f_bounded ==
 /// f_des exactly). On a non-finite model acceleration or zero-acceleration
 /// force, returns 0 and leaves *f_bounded = f_des: the caller treats the step
 /// as invalid.
 double BoundNominal(const DynamicsTerms& terms, const Cholesky6& inertia,
-                    const Vector6d& leg_speed_mps, double leg_friction_nspm,
-                    const Vector6d& disturbance_n, const Vector6d& max_accel, const Vector6d& f_des,
-                    Vector6d* f_bounded);
+                    LegJacobianFactor* h_factor, const Vector6d& leg_speed_mps,
+                    double leg_friction_nspm, const Vector6d& disturbance_n,
+                    const Vector6d& max_accel, const Vector6d& f_des, Vector6d* f_bounded);
 
 }  // namespace stewart::safety

@@ -157,8 +157,9 @@ class SafetyFilter {
                     const Vector6d& disturbance_n) const;
   /// The safe stop as the answer of a step whose QP has no solution.
   void ApplySafeStop(const StepInput& in, SafetyDiagnostics* d) const;
+  /// T into `map` (and L_M into `l_m` with the acceleration metric).
   bool ComputeMetricMap(const DynamicsTerms& terms, const BarrierIntermediates& x,
-                        LegJacobianFactor* factor, Matrix6d* map) const;
+                        LegJacobianFactor* factor, Matrix6d* l_m, Matrix6d* map) const;
   void SolveUnlimited(const StepInput& in, const FilterWorkspace& ws, SafetyDiagnostics* d) const;
   /// ws->problem from the barriers and ws->metric_map.
   void ComposeProblem(const BarrierEvaluation& b, FilterWorkspace* ws) const;
