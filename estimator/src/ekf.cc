@@ -114,12 +114,20 @@ void SubtractGramBlock(const Eigen::Matrix<double, kEkfPaddedSize, M>& g,
   }
 }
 
+// The upper off-diagonal 6x6 blocks := the mirror of the lower ones.
+template <int N>
+void MirrorOffDiagonalBlocks(Eigen::Matrix<double, N, N>* p) {
+  static_assert(N == 24, "four blocks of 6");
+  p->template block<6, N - 6>(0, 6) = p->template block<N - 6, 6>(6, 0).transpose();
+  p->template block<6, N - 12>(6, 12) = p->template block<N - 12, 6>(12, 6).transpose();
+  p->template block<6, N - 18>(12, 18) = p->template block<N - 18, 6>(18, 12).transpose();
+}
+
 // Upper triangle := lower triangle, by 6x6 blocks with fixed bounds (fully
 // unrolled; the triangular double loop with variable bounds over 276 entries
 // was a fifth of the prediction).
 template <int N>
 void MirrorLowerTriangle(Eigen::Matrix<double, N, N>* p) {
-  static_assert(N % 6 == 0, "whole 6x6 blocks");
   for (int b = 0; b < N; b += 6) {
 #pragma GCC unroll 6
     for (int j = 1; j < 6; ++j) {
@@ -127,14 +135,7 @@ void MirrorLowerTriangle(Eigen::Matrix<double, N, N>* p) {
       for (int i = 0; i < j; ++i) (*p)(b + i, b + j) = (*p)(b + j, b + i);
     }
   }
-  p->template block<6, N - 6>(0, 6) = p->template block<N - 6, 6>(6, 0).transpose();
-  if constexpr (N > 12) {
-    p->template block<6, N - 12>(6, 12) = p->template block<N - 12, 6>(12, 6).transpose();
-  }
-  if constexpr (N > 18) {
-    p->template block<6, N - 18>(12, 18) = p->template block<N - 18, 6>(18, 12).transpose();
-  }
-  static_assert(N <= 24, "blocks beyond the fourth are not mirrored");
+  MirrorOffDiagonalBlocks(p);
 }
 
 template <int M>
@@ -143,14 +144,11 @@ void SubtractGram(const Eigen::Matrix<double, kEkfPaddedSize, M>& g,
   static_assert(kEkfQd == 6 && kEkfDisturbance == 12 && kEkfGyroBias == 18 && kEkfAccelBias == 21 &&
                     kEkfPaddedSize == 24,
                 "the blocks below follow the state layout");
-  constexpr int kN = kEkfPaddedSize;
   SubtractGramBlock<0, 6>(g, p);
   SubtractGramBlock<6, 12>(g, p);
   SubtractGramBlock<12, 18>(g, p);
   SubtractGramBlock<18, kEkfStateSize>(g, p);
-  p->template block<6, kN - 6>(0, 6) = p->template block<kN - 6, 6>(6, 0).transpose();
-  p->template block<6, kN - 12>(6, 12) = p->template block<kN - 12, 6>(12, 6).transpose();
-  p->template block<6, kN - 18>(12, 18) = p->template block<kN - 18, 6>(18, 12).transpose();
+  MirrorOffDiagonalBlocks(p);
 }
 
 }  // namespace

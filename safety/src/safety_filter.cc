@@ -222,10 +222,8 @@ Vector6d SafetyFilter::StepWithTerms(const DynamicsTerms& terms, const Vector6d&
     if (variant_ == SafetyVariant::kQpReference || variant_ == SafetyVariant::kUncomposed ||
         force_limits_) {
       // These pose the QP in y = T^-1 F, so they need T itself.
-      ok = ComputeMetricMap(terms, ws.barrier, &ws.leg_jacobian, &ws.inertia_factor_l,
-                            &ws.metric_map);
+      ok = ComputeStepMetricMap(terms, &ws);
       metric_map_ready = ok;
-      ws.inertia_factor_l_ready = ok && metric_ != CorrectionMetric::kForce;
       if (ok && variant_ == SafetyVariant::kQpReference) {
         SolveReference(in, &ws, d);
       } else if (ok && variant_ == SafetyVariant::kUncomposed) {
@@ -253,11 +251,7 @@ Vector6d SafetyFilter::StepWithTerms(const DynamicsTerms& terms, const Vector6d&
     d->mu_p = d->mu_v = 0.0;
     d->mu_force.setZero();
     d->flags = (d->flags & ~(kFlagFallback | kFlagForceLimited)) | kFlagPerBarrier;
-    if (!metric_map_ready) {
-      ok = ComputeMetricMap(terms, ws.barrier, &ws.leg_jacobian, &ws.inertia_factor_l,
-                            &ws.metric_map);
-      ws.inertia_factor_l_ready = ok && metric_ != CorrectionMetric::kForce;
-    }
+    ok = metric_map_ready || ComputeStepMetricMap(terms, &ws);
     if (ok) SolveUncomposed(in, &ws, d);
     ok = ok && d->f_safe.allFinite();
   }
@@ -346,6 +340,13 @@ Matrix6d SafetyFilter::MetricMap(const DynamicsTerms& terms) const {
   Matrix6d l_m, map;
   ComputeMetricMap(terms, x, &factor, &l_m, &map);
   return map;
+}
+
+bool SafetyFilter::ComputeStepMetricMap(const DynamicsTerms& terms, FilterWorkspace* ws) const {
+  const bool ok = ComputeMetricMap(terms, ws->barrier, &ws->leg_jacobian, &ws->inertia_factor_l,
+                                   &ws->metric_map);
+  ws->inertia_factor_l_ready = ok && metric_ != CorrectionMetric::kForce;
+  return ok;
 }
 
 bool SafetyFilter::ComputeMetricMap(const DynamicsTerms& terms, const BarrierIntermediates& x,

@@ -157,6 +157,9 @@ class SafetyFilter {
                     const Vector6d& disturbance_n) const;
   /// The safe stop as the answer of a step whose QP has no solution.
   void ApplySafeStop(const StepInput& in, SafetyDiagnostics* d) const;
+  /// The step's T, L_M and H factor in `ws` (ComputeMetricMap), and the flag
+  /// that lets the un-composed posing reuse that L_M.
+  bool ComputeStepMetricMap(const DynamicsTerms& terms, FilterWorkspace* ws) const;
   /// T into `map` (and L_M into `l_m` with the acceleration metric).
   bool ComputeMetricMap(const DynamicsTerms& terms, const BarrierIntermediates& x,
                         LegJacobianFactor* factor, Matrix6d* l_m, Matrix6d* map) const;
