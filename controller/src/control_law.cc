@@ -16,8 +16,8 @@ Vector6d NominalForce(const PlatformParams& platform, const ControllerConfig& ga
 
 Vector6d NominalForce(const PlatformParams& platform, const ControllerConfig& gains,
                       const Vector6d& q, const Vector6d& qd, const Vector6d& disturbance_n,
-                      const Setpoint& setpoint, DynamicsTerms* terms) {
-  EvaluateDynamics(platform, q, qd, terms);
+                      const Setpoint& setpoint, DynamicsTerms* terms, SharedDynamicsTerms* shared) {
+  EvaluateDynamics(platform, shared, q, qd, terms);
   // The legs lose LegViscousFriction on the way: command it on top.
   return InverseDynamics(*terms, PdAcceleration(gains, q, qd, setpoint), disturbance_n) -
          LegViscousFriction(gains.leg_friction_nspm, terms->H.transpose() * qd);

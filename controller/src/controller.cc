@@ -13,6 +13,10 @@ Controller::Controller(const PlatformParams& platform, const ControllerConfig& g
       scenario_(std::move(scenario)),
       active_(Setpoint::HoldAt(home_pose)) {}
 
+void Controller::ShareModelTerms(std::shared_ptr<SharedDynamicsTerms> shared) {
+  shared_terms_ = AttachSharedTerms(platform_, std::move(shared));
+}
+
 SetpointStatus Controller::Check(const Setpoint& setpoint) const {
   if (!setpoint.AllFinite()) return SetpointStatus::kNonFinite;
   if (!PoseInWorkspace(platform_, setpoint.q_des)) return SetpointStatus::kOutsideWorkspace;
@@ -68,7 +72,7 @@ StepStatus Controller::Step(int64_t utime, const Vector6d& q, const Vector6d& qd
 
   const Vector6d force_n = NominalForce(
       platform_, gains_, q, qd, gains_.compensate_disturbance ? disturbance_n : Vector6d::Zero(),
-      active_, &terms_);
+      active_, &terms_, shared_terms_.get());
   if (!force_n.allFinite()) return StepStatus::kNonFiniteForce;
   out->force_n = force_n;
   out->setpoint = active_;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include "stewart/estimator/measurement_models.h"
 #include "stewart/estimator/process_model.h"
@@ -198,6 +199,10 @@ const Ekf::TimedCommand* Ekf::ActingCommand(int64_t interval_start_utime) const 
   return nullptr;
 }
 
+void Ekf::ShareModelTerms(std::shared_ptr<SharedDynamicsTerms> shared) {
+  shared_terms_ = AttachSharedTerms(params_, std::move(shared));
+}
+
 void Ekf::Reset() {
   initialized_ = false;
   x_.setZero();
@@ -319,7 +324,7 @@ void Ekf::Predict(double dt_s, int64_t utime, const EulerAngleTrig& trig, bool d
   if (use_dynamics) {
     DynamicsAccelerationJacobians(params_, leg_damping_nspm_, q, trig, qd, command->force_n,
                                   x_.segment<6>(kEkfDisturbance), &qdd_, &dqdd_dq_, &dqdd_dqd_,
-                                  &m_inv_);
+                                  &m_inv_, shared_terms_.get());
     sigma_lin = config_.dynamics_accel_std_mps2;
     sigma_ang = config_.dynamics_angaccel_std_radps2;
   } else if (legs_held) {

@@ -3,6 +3,7 @@
 #include "stewart/model/dynamics.h"
 #include "stewart/model/linear_algebra6.h"
 #include "stewart/model/rotation.h"
+#include "stewart/model/shared_dynamics_terms.h"
 
 namespace stewart {
 namespace {
@@ -79,9 +80,10 @@ void DynamicsAccelerationJacobians(const PlatformParams& params, double friction
                                    const Vector6d& q, const EulerAngleTrig& trig,
                                    const Vector6d& qd, const Vector6d& force_n,
                                    const Vector6d& disturbance_n, Vector6d* qdd, Matrix6d* dqdd_dq,
-                                   Matrix6d* dqdd_dqd, Matrix6d* m_inv) {
+                                   Matrix6d* dqdd_dqd, Matrix6d* m_inv,
+                                   SharedDynamicsTerms* shared) {
   DynamicsTerms terms;
-  EvaluateDynamics(params, q, qd, &terms);
+  EvaluateDynamics(params, shared, q, qd, &terms);
   const Matrix6d& H = terms.H;
   const Vector6d leg_speed_mps = H.transpose() * qd;
   const Vector6d force = force_n - friction_nspm * leg_speed_mps;

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 #include "stewart/common/check.h"
 #include "stewart/model/linear_algebra6.h"
@@ -115,6 +116,10 @@ void SafetyFilter::set_variant(SafetyVariant variant) {
   variant_ = variant;
 }
 
+void SafetyFilter::ShareModelTerms(std::shared_ptr<SharedDynamicsTerms> shared) {
+  shared_terms_ = AttachSharedTerms(platform_, std::move(shared));
+}
+
 Vector6d SafetyFilter::Step(const Vector6d& q, const Vector6d& qd, const Vector6d& f_des,
                             SafetyDiagnostics* diagnostics) {
   return Step(q, qd, f_des, GeneralizedDisturbance{}, diagnostics);
@@ -128,7 +133,7 @@ Vector6d SafetyFilter::Step(const Vector6d& q, const Vector6d& qd, const Vector6
   const auto start = std::chrono::steady_clock::now();
   DynamicsTerms& terms = workspace_.terms;
   if (q.allFinite() && qd.allFinite()) {
-    EvaluateDynamics(platform_, q, qd, &terms);
+    EvaluateDynamics(platform_, shared_terms_.get(), q, qd, &terms);
   } else {
     terms.M.setConstant(NAN);  // marks the terms invalid for StepWithTerms
   }
@@ -299,7 +304,7 @@ Vector6d SafetyFilter::SafeStopCommand(const Vector6d& q, const Vector6d& qd,
   DynamicsTerms& terms = workspace_.terms;
   bool state_valid = q.allFinite() && qd.allFinite();
   if (state_valid) {
-    EvaluateDynamics(platform_, q, qd, &terms);
+    EvaluateDynamics(platform_, shared_terms_.get(), q, qd, &terms);
     state_valid =
         terms.M.allFinite() && PoseProblems(platform_, q, terms.leg_length_m) == kPosePlausible;
   }

@@ -3,12 +3,14 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 #include <sstream>
 
 #include "stewart/common/health_counters.h"
 #include "stewart/common/signals.h"
 #include "stewart/controller/controller_process.h"
 #include "stewart/estimator/estimator_process.h"
+#include "stewart/model/shared_dynamics_terms.h"
 #include "stewart/plant_sim/disturbance_source.h"
 #include "stewart/plant_sim/ode_integrator.h"
 #include "stewart/plant_sim/plant.h"
@@ -91,6 +93,13 @@ ClosedLoopSummary RunClosedLoop(const StackConfig& config, const Scenario& scena
   supervisor.auto_arm = true;
   safety::SafetyProcess safety(config.platform, config.safety, config.actuators, supervisor,
                                options.reference, &safety_counters, config.lcm.time_plausibility);
+  std::shared_ptr<SharedDynamicsTerms> shared_terms;
+  if (options.share_model_terms) {
+    shared_terms = std::make_shared<SharedDynamicsTerms>(config.platform);
+    estimator.ShareModelTerms(shared_terms);
+    controller.ShareModelTerms(shared_terms);
+    safety.ShareModelTerms(shared_terms);
+  }
 
   const std::int64_t period_us = std::llround(1e6 / sensors.rate_hz);
   const long ticks = std::lround(options.duration_s * 1e6 / static_cast<double>(period_us));
@@ -245,6 +254,10 @@ ClosedLoopSummary RunClosedLoop(const StackConfig& config, const Scenario& scena
       out.failure = "non-finite plant state";
       break;
     }
+  }
+  if (shared_terms) {
+    out.model_evaluations = shared_terms->evaluations();
+    out.model_evaluations_shared = shared_terms->hits();
   }
   out.endstop_hits = plant.counters().endstop_hits;
   out.stiff_fallbacks = plant.counters().stiff_fallbacks;

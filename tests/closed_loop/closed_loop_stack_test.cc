@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <sstream>
 #include <string>
 
 #include "stewart/config/default_config.h"
@@ -73,6 +74,26 @@ TEST(PaperScenario, TracksTheSetpointsTheLimitsAllow) {
   EXPECT_GT(s.qd_max(0), 0.015 - margin - 1e-3);
   EXPECT_LT(s.q_max.tail<3>().cwiseAbs().maxCoeff(), 0.05);
   EXPECT_LT(s.q_min.tail<3>().cwiseAbs().maxCoeff(), 0.05);
+}
+
+TEST(SharedModelTerms, OneEvaluationPerEstimateGivesTheSameRunBitForBit) {
+  // The estimator's next prediction, the controller and the filter evaluate
+  // the model at the same estimate: shared, they evaluate it once, and every
+  // tick's trajectory, estimate and command are what three evaluations give.
+  const Scenario scenario = LoadScenario(ResolveScenarioPath("paper"));
+  ClosedLoopOptions options;
+  options.duration_s = 6.0;
+  std::ostringstream shared_csv, own_csv;
+  options.share_model_terms = true;
+  const ClosedLoopSummary shared =
+      RunClosedLoop(DefaultStackConfig(), scenario, options, &shared_csv);
+  options.share_model_terms = false;
+  const ClosedLoopSummary own = RunClosedLoop(DefaultStackConfig(), scenario, options, &own_csv);
+  ASSERT_TRUE(shared.completed && own.completed);
+  EXPECT_EQ(shared_csv.str(), own_csv.str());
+  EXPECT_GT(shared.model_evaluations, 5000);
+  EXPECT_GE(shared.model_evaluations_shared, 2 * shared.model_evaluations - 100);
+  EXPECT_EQ(own.model_evaluations_shared, 0);
 }
 
 TEST(CorrectionMetric, ForceMetricLetsRotationsAbsorbTheCorrection) {

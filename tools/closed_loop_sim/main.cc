@@ -37,6 +37,10 @@ int main(int argc, char** argv) {
   app.add_option("--k-position", k_position, "override safety.k_position");
   app.add_option("--variant", variant, kSafetyVariantNames.Names() + " (qp: Clp reference)");
   app.add_flag("--no-filter", options.no_filter, "pass F_des through (to see what it prevents)");
+  bool own_terms = false;
+  app.add_flag("--no-shared-terms", own_terms,
+               "estimator, controller and filter each evaluate the model themselves "
+               "(the same results; to measure what sharing one evaluation saves)");
   app.add_option("--truth", truth_path,
                  "the plant's physics differ from the config (docs/simulation.md, \"Truth\")")
       ->check(CLI::ExistingFile);
@@ -51,12 +55,19 @@ int main(int argc, char** argv) {
     if (!truth_path.empty()) options.truth = LoadPlantTruth(config, truth_path);
     const Scenario scenario = LoadScenario(ResolveScenarioPath(scenario_name));
     options.duration_s = duration_s.value_or(scenario.duration_s());
+    options.share_model_terms = !own_terms;
     std::unique_ptr<std::ofstream> csv;
     if (!csv_path.empty()) csv = std::make_unique<std::ofstream>(csv_path);
     safety::ClpReferenceQp reference;
     options.reference = &reference;
     const ClosedLoopSummary s = RunClosedLoop(config, scenario, options, csv.get());
     std::printf("%s", FormatSummary(config, s).c_str());
+    if (s.model_evaluations > 0) {
+      std::printf(
+          "model terms: %ld evaluations for estimator, controller and filter, %ld answers "
+          "shared\n",
+          s.model_evaluations, s.model_evaluations_shared);
+    }
     return s.completed ? 0 : 1;
   } catch (const std::exception& e) {
     spdlog::error("{}", e.what());

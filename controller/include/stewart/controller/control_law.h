@@ -12,6 +12,7 @@
 #include "stewart/controller/setpoint.h"
 #include "stewart/model/dynamics.h"
 #include "stewart/model/platform_params.h"
+#include "stewart/model/shared_dynamics_terms.h"
 
 namespace stewart {
 
@@ -26,8 +27,11 @@ Vector6d NominalForce(const PlatformParams& platform, const ControllerConfig& ga
                       DynamicsTerms* terms);
 /// The same, cancelling the estimated model error d (model/disturbance.h):
 ///   H (F_des + F_friction) + d = M u + C qd + G.
+/// `shared`: the model terms through it when not null (its parameters are
+/// `platform`: AttachSharedTerms).
 Vector6d NominalForce(const PlatformParams& platform, const ControllerConfig& gains,
                       const Vector6d& q, const Vector6d& qd, const Vector6d& disturbance_n,
-                      const Setpoint& setpoint, DynamicsTerms* terms);
+                      const Setpoint& setpoint, DynamicsTerms* terms,
+                      SharedDynamicsTerms* shared = nullptr);
 
 }  // namespace stewart

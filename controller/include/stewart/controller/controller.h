@@ -2,6 +2,7 @@
 // The controller's state machine, free of LCM: setpoint source (scenario or
 // live), workspace rejection, time from the state's utime, and the control law.
 #include <cstdint>
+#include <memory>
 #include <optional>
 
 #include "stewart/common/enum_table.h"
@@ -82,10 +83,16 @@ class Controller {
   const Setpoint& active_setpoint() const { return active_; }
   const DynamicsTerms& last_terms() const { return terms_; }
 
+  /// Evaluates the model through `shared` (in process: the estimator and
+  /// the filter evaluate it at the same estimates). std::invalid_argument
+  /// when its parameters are not this controller's; null: its own.
+  void ShareModelTerms(std::shared_ptr<SharedDynamicsTerms> shared);
+
  private:
   SetpointStatus Check(const Setpoint& setpoint) const;
 
   PlatformParams platform_;
+  std::shared_ptr<SharedDynamicsTerms> shared_terms_;
   ControllerConfig gains_;
   std::optional<Scenario> scenario_;
   Setpoint active_;

@@ -10,7 +10,9 @@
 // node, nullopt in replay; it only widens the window after a gap and never
 // reaches the control law, whose time is the state's.
 #include <cstdint>
+#include <memory>
 #include <optional>
+#include <utility>
 
 #include "stewart/common/health_counters.h"
 #include "stewart/common/input_time_check.h"
@@ -62,6 +64,10 @@ class ControllerProcess {
   void RestartScenario() { controller_.RestartScenarioAtFirstMotionClock(); }
 
   const Controller& controller() const { return controller_; }
+  /// Controller::ShareModelTerms.
+  void ShareModelTerms(std::shared_ptr<SharedDynamicsTerms> shared) {
+    controller_.ShareModelTerms(std::move(shared));
+  }
 
  private:
   Controller controller_;

@@ -5,6 +5,7 @@
 // model, the tuning and the measured accuracy. No LCM, no heap allocation
 // per update, and time only from the samples' utime.
 #include <array>
+#include <memory>
 #include <optional>
 
 #include "stewart/estimator/ekf_types.h"
@@ -13,6 +14,7 @@
 #include "stewart/model/platform_params.h"
 #include "stewart/model/rotation.h"
 #include "stewart/model/sensor_params.h"
+#include "stewart/model/shared_dynamics_terms.h"
 
 namespace stewart {
 
@@ -35,6 +37,12 @@ class Ekf {
   /// tools; the process initialises itself from the legs).
   void Initialize(int64_t utime, const Vector6d& q, const Vector6d& qd, const EkfVector& std);
   void Reset();
+
+  /// Evaluates the model through `shared` (in process: the controller and
+  /// the filter evaluate it at the estimate this filter publishes, which the
+  /// next prediction starts from). std::invalid_argument when its parameters
+  /// are not this filter's; null: evaluations of its own.
+  void ShareModelTerms(std::shared_ptr<SharedDynamicsTerms> shared);
 
   bool initialized() const { return initialized_; }
   const EkfVector& x() const { return x_; }
@@ -67,6 +75,7 @@ class Ekf {
   bool EstimatesAccelBias() const { return config_.initial_accel_bias_std_mps2 > 0.0; }
 
   PlatformParams params_;
+  std::shared_ptr<SharedDynamicsTerms> shared_terms_;
   ActuatorConfig actuators_;
   double leg_damping_nspm_;  // N s/m: screw friction + back-EMF (ModelLegDampingNspm)
   // s: how fast held DC-motor legs stop, reflected mass / back-EMF damping

@@ -6,7 +6,9 @@
 // converts messages and publishes; replay drives the same class.
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <optional>
+#include <utility>
 
 #include "stewart/common/health_counters.h"
 #include "stewart/common/input_time_check.h"
@@ -88,6 +90,10 @@ class EstimatorProcess {
                std::optional<int64_t> receive_wall_us = std::nullopt);
 
   const Ekf& ekf() const { return ekf_; }
+  /// Ekf::ShareModelTerms.
+  void ShareModelTerms(std::shared_ptr<SharedDynamicsTerms> shared) {
+    ekf_.ShareModelTerms(std::move(shared));
+  }
   /// The acceptor of `trust` (nullptr without it).
   const SafeCommandAcceptor* acceptor() const { return acceptor_ ? &*acceptor_ : nullptr; }
 

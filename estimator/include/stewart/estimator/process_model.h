@@ -9,6 +9,7 @@
 // N/(m/s), qdd in m/s^2 and rad/s^2 (Euler accelerations).
 #include "stewart/model/platform_params.h"
 #include "stewart/model/rotation.h"
+#include "stewart/model/shared_dynamics_terms.h"
 #include "stewart/model/types.h"
 
 namespace stewart {
@@ -35,10 +36,13 @@ void DynamicsAccelerationJacobians(const PlatformParams& params, double friction
 /// qdd = M^-1 (H (F - c_v ld) + d - C qd - G), and dqdd/dd = M^-1 in
 /// `m_inv`. d is constant in q, so the other Jacobians are those above (the
 /// inertial part -M^-1 dM/dq qdd, which d enters, is left out as there).
+/// `shared`: the model terms through it when not null (its parameters are
+/// `params`: AttachSharedTerms).
 void DynamicsAccelerationJacobians(const PlatformParams& params, double friction_nspm,
                                    const Vector6d& q, const EulerAngleTrig& trig,
                                    const Vector6d& qd, const Vector6d& force_n,
                                    const Vector6d& disturbance_n, Vector6d* qdd, Matrix6d* dqdd_dq,
-                                   Matrix6d* dqdd_dqd, Matrix6d* m_inv);
+                                   Matrix6d* dqdd_dqd, Matrix6d* m_inv,
+                                   SharedDynamicsTerms* shared = nullptr);
 
 }  // namespace stewart

@@ -12,8 +12,11 @@
 //   SafetyFilter filter(config.platform, config.safety, config.actuators);
 //   SafetyDiagnostics diag;
 //   Vector6d f_safe = filter.Step(q, qd, f_des, &diag);
+#include <memory>
+
 #include "stewart/model/actuator_params.h"
 #include "stewart/model/dynamics.h"
+#include "stewart/model/shared_dynamics_terms.h"
 #include "stewart/safety/constraint_set.h"
 #include "stewart/safety/diagnostics.h"
 #include "stewart/safety/filter_workspace.h"
@@ -53,6 +56,11 @@ class SafetyFilter {
   /// outlive the filter).
   SafetyFilter(const PlatformParams& platform, const SafetyConfig& safety,
                const ActuatorConfig& actuators, ReferenceQpSolver* reference = nullptr);
+
+  /// Evaluates the model through `shared` (in process: the estimator and
+  /// the controller evaluate it at the same estimates). std::invalid_argument
+  /// when its parameters are not this filter's; null: its own.
+  void ShareModelTerms(std::shared_ptr<SharedDynamicsTerms> shared);
 
   /// Full step: evaluates the model terms at (q, qd), then StepWithTerms.
   /// Output is always finite; see diagnostics->flags. diagnostics->compute_ns
@@ -196,6 +204,7 @@ class SafetyFilter {
   }
 
   PlatformParams platform_;
+  std::shared_ptr<SharedDynamicsTerms> shared_terms_;
   ConstraintSet constraints_;
   SafetyVariant variant_;
   CorrectionMetric metric_;

@@ -15,7 +15,9 @@
 // reaches the filter, the watchdog or a command.
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <optional>
+#include <utility>
 
 #include "stewart/common/health_counters.h"
 #include "stewart/common/input_time_check.h"
@@ -71,6 +73,10 @@ class SafetyProcess {
                  std::optional<int64_t> receive_wall_us = std::nullopt);
 
   const SafetyFilter& filter() const { return filter_; }
+  /// SafetyFilter::ShareModelTerms.
+  void ShareModelTerms(std::shared_ptr<SharedDynamicsTerms> shared) {
+    filter_.ShareModelTerms(std::move(shared));
+  }
   /// The supervisor, for operator commands and outside faults (the node,
   /// replay).
   Supervisor& supervisor() { return supervisor_; }

@@ -21,6 +21,10 @@ struct ClosedLoopOptions {
   double duration_s = 40.0;
   bool perfect_state = false;  ///< ground truth to controller and filter instead of the EKF
   bool no_filter = false;      ///< F* = F_des (to measure what the filter prevents)
+  /// The estimator, the controller and the filter evaluate the model once
+  /// per estimate between them (SharedDynamicsTerms: the same terms, bit
+  /// for bit, as three evaluations); false: each its own.
+  bool share_model_terms = true;
   /// The reference solver for variant qp (must outlive the run); unused otherwise.
   safety::ReferenceQpSolver* reference = nullptr;
   std::uint64_t seed = 1;  ///< sensor noise seed (overrides sensors.seed)
@@ -54,9 +58,13 @@ struct ClosedLoopSummary {
   double max_limit_excess = -1e9;          ///< largest excess of any configured limit (m or m/s)
   std::string max_limit_excess_name;       ///< which limit, e.g. "xd upper"
   std::vector<LimitMargin> limit_margins;  ///< every limit, LimitNames order
-  std::string failure;        ///< why the run stopped early (plant integration), "" if it did not
-  double rms_q_error = 0.0;   ///< estimate vs truth, translations (m)
-  double rms_qd_error = 0.0;  ///< estimate vs truth, translational rates (m/s)
+  std::string failure;  ///< why the run stopped early (plant integration), "" if it did not
+  /// Model evaluations the stack's components made between them and how
+  /// many more answered from the shared terms (0 without sharing).
+  long model_evaluations = 0;
+  long model_evaluations_shared = 0;
+  double rms_q_error = 0.0;               ///< estimate vs truth, translations (m)
+  double rms_qd_error = 0.0;              ///< estimate vs truth, translational rates (m/s)
   safety::FilterCaseCounts case_ticks{};  ///< ticks per FilterCase
   long infeasible_ticks = 0;
   /// Ticks whose nominal exceeded the per-period bound (FLAG_NOMINAL_BOUNDED).
