@@ -40,6 +40,8 @@ const char* EkfEventName(EkfEvent event) {
       return "predict_legs_held";
     case kEventPoseReopened:
       return "pose_reopened";
+    case kEventRatesReopened:
+      return "rates_reopened";
   }
   return "unknown";
 }

@@ -35,7 +35,11 @@ RunStats RunScenario(const StackConfig& config, unsigned seed, double t_end_s, d
     TruthSample now = truth.Next();
     const double t_s = static_cast<double>(now.utime) * 1e-6;
     if (t_s > t_end_s) break;
-    if (k > 0) ekf->SetForceCommand(previous.utime, previous.force_n);
+    if (k > 0) {
+      Vector6d told_n = previous.force_n;
+      if (hooks.command) hooks.command(k, &told_n);
+      ekf->SetForceCommand(previous.utime, told_n);
+    }
     SensorSample sample = now.sensors;
     if (hooks.before) hooks.before(k, &sample);
     const UpdateResult result = ekf->Update(sample);

@@ -22,6 +22,9 @@ struct RunStats {
 /// injection), sees the EKF after it. Errors are accumulated for t >= settle_s.
 struct RunHooks {
   std::function<void(int k, SensorSample*)> before;
+  /// May edit the command the EKF is told was applied before sample k (the
+  /// truth applied the unedited one): a model error.
+  std::function<void(int k, Vector6d* force_n)> command;
   std::function<void(int k, const Ekf&, const TruthSample&, const UpdateResult&)> after;
 };
 

@@ -118,6 +118,10 @@ class Ekf {
   const TimedCommand* ActingCommand(int64_t interval_start_utime) const;
   int consecutive_leg_rejections_ = 0;
   int consecutive_accel_gated_ = 0;
+  int consecutive_gyro_gated_ = 0;
+  /// See CorrectGyro: the gyro gated this many samples in a row first (a
+  /// single bad reading is only gated).
+  static constexpr int kReopenAfterGatedGyro = 3;
   /// See ReopenPoseAfterUnmodelledForce: the legs gated this many samples
   /// in a row first (a single bad reading is only gated), and the longest
   /// window the drift is sized for (s).

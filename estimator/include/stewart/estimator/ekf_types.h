@@ -88,7 +88,10 @@ enum EkfEvent : uint32_t {
   /// the pose and velocity uncertainty widened by the drift of an unmodelled
   /// force, and the legs used (Ekf::ReopenPoseAfterUnmodelledForce).
   kEventPoseReopened = 1u << 17,
-  kEventLast = kEventPoseReopened,
+  /// The gyro gated 3 samples in a row: the angular rates' uncertainty
+  /// widened by the disagreement, and the gyro used (Ekf::CorrectGyro).
+  kEventRatesReopened = 1u << 18,
+  kEventLast = kEventRatesReopened,
 };
 
 /// Short snake_case name of one event bit (health counter names).
