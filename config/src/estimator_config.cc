@@ -22,6 +22,9 @@ EstimatorConfig ParseEstimatorConfig(const ConfigNode& estimator) {
   e.initial_accel_bias_std_mps2 = estimator.NonNegativeDouble("initial_accel_bias_std_mps2");
   e.accel_bias_walk_mps2_per_sqrt_s =
       estimator.NonNegativeDouble("accel_bias_walk_mps2_per_sqrt_s");
+  if (estimator.Has("accel_bias_axes")) {
+    e.estimate_accel_bias_z = estimator.Choice("accel_bias_axes", {"xyz", "xy"}) == "xyz";
+  }
   e.leg_noise_inflation = estimator.PositiveDouble("leg_noise_inflation");
   e.use_accelerometer = estimator.Bool("use_accelerometer");
   e.gating_chi2 = estimator.PositiveDouble("gating_chi2");

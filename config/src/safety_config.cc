@@ -1,3 +1,4 @@
+#include <cmath>
 #include <stdexcept>
 
 #include "stewart/config/sections.h"
@@ -71,6 +72,11 @@ SafetyConfig ParseSafetyConfig(const ConfigNode& safety) {
   }
   if (safety.Has("position_robust_margin_w")) {
     s.position_robust_margin_w = safety.NonNegativeDouble("position_robust_margin_w");
+  }
+  if (safety.Has("joint_position_tolerance")) {
+    const ConfigNode tolerance = safety.Child("joint_position_tolerance");
+    s.joint_radius_tolerance_m = tolerance.NonNegativeDouble("radius_m");
+    s.joint_angle_tolerance_rad = tolerance.NonNegativeDouble("angle_deg") * M_PI / 180.0;
   }
   if (safety.Has("model_leg_friction")) s.model_leg_friction = safety.Bool("model_leg_friction");
   if (safety.Has("position_rate_per_s")) {

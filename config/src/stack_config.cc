@@ -67,6 +67,7 @@ StackConfig ParseRoot(const YAML::Node& yaml, const std::string& source) {
   // One sample period of the plant's zero-order hold: the nominal's bound
   // (safety/nominal_bound.h) is a velocity step per period.
   c.safety.sample_period_s = 1.0 / c.sensors.rate_hz;
+  for (int i = 0; i < kNumAxes; ++i) c.safety.home_pose[static_cast<size_t>(i)] = c.home_pose(i);
   ValidateStackConfig(c);
   return c;
 }

@@ -272,6 +272,7 @@ bool Ekf::InitializeFromLegs(const SensorSample& sample, uint32_t* events) {
   std.segment<3>(kEkfQd + 3).setConstant(config_.initial_angular_rate_std_radps);
   std.segment<3>(kEkfGyroBias).setConstant(config_.initial_gyro_bias_std_radps);
   std.segment<3>(kEkfAccelBias).setConstant(config_.initial_accel_bias_std_mps2);
+  if (!config_.estimate_accel_bias_z) std(kEkfAccelBias + 2) = 0.0;
   std.segment<3>(kEkfDisturbance).setConstant(config_.initial_disturbance_std_n);
   std.segment<3>(kEkfDisturbance + 3).setConstant(config_.initial_disturbance_std_nm);
   // A restart keeps what was learnt of d (a payload does not go away when
@@ -392,7 +393,9 @@ void Ekf::Predict(double dt_s, int64_t utime, const EulerAngleTrig& trig, bool d
   P_.diagonal().segment<3>(kEkfGyroBias).array() += walk * walk * dt_s;
   if (EstimatesAccelBias()) {
     const double walk_a = config_.accel_bias_walk_mps2_per_sqrt_s;
-    P_.diagonal().segment<3>(kEkfAccelBias).array() += walk_a * walk_a * dt_s;
+    P_.diagonal().segment<2>(kEkfAccelBias).array() += walk_a * walk_a * dt_s;
+    if (config_.estimate_accel_bias_z)
+      P_(kEkfAccelBias + 2, kEkfAccelBias + 2) += walk_a * walk_a * dt_s;
   }
   if (config_.estimate_disturbance) {
     const double walk_n = config_.disturbance_walk_n_per_sqrt_s;

@@ -4,6 +4,7 @@
 #include "safety_node.h"
 #include "stewart/node/node_main.h"
 #include "stewart/safety/clp_reference_qp.h"
+#include "stewart/safety/constraint_set.h"
 
 int main(int argc, char** argv) {
   std::string variant;
@@ -36,6 +37,14 @@ int main(int argc, char** argv) {
                      stewart::kSafetyVariantNames.Name(config.safety.variant),
                      config.lcm.channels.command_nominal, config.lcm.channels.command_safe,
                      config.lcm.url);
+        const stewart::Vector6d margin =
+            stewart::safety::JointToleranceMargin(config.platform, config.safety);
+        if (margin.head<3>().maxCoeff() > 0.0) {
+          spdlog::info(
+              "safety: the joints' tolerance draws the position limits in by x {:.1f}, y {:.1f}, "
+              "z {:.1f} mm",
+              1e3 * margin(0), 1e3 * margin(1), 1e3 * margin(2));
+        }
         return node.Run();
       });
 }

@@ -1,10 +1,45 @@
 #include "stewart/safety/constraint_set.h"
 
 #include <cmath>
+#include <vector>
 
 #include "stewart/common/check.h"
+#include "stewart/model/joint_tolerance.h"
+#include "stewart/model/kinematics.h"
 
 namespace stewart::safety {
+
+Vector6d JointToleranceMargin(const PlatformParams& platform, const SafetyConfig& safety) {
+  const JointTolerance tolerance{safety.joint_radius_tolerance_m, safety.joint_angle_tolerance_rad};
+  if (tolerance.IsZero()) return Vector6d::Zero();
+  Vector6d home;
+  for (int i = 0; i < kNumAxes; ++i) home(i) = safety.home_pose[static_cast<size_t>(i)];
+  // Per translational axis: home, its limits, a lone limit mirrored.
+  std::array<std::vector<double>, 3> values;
+  for (int a = 0; a < 3; ++a) values[static_cast<size_t>(a)] = {home(a)};
+  for (const PositionLimitConfig& l : safety.position_limits) {
+    if (l.axis >= 3) continue;
+    std::vector<double>& v = values[static_cast<size_t>(l.axis)];
+    for (const std::optional<double>& limit : {l.lower, l.upper}) {
+      if (limit) v.push_back(*limit);
+    }
+    if (l.lower.has_value() != l.upper.has_value()) {
+      v.push_back(2.0 * home(l.axis) - (l.lower ? *l.lower : *l.upper));
+    }
+  }
+  Vector6d margin = PoseErrorBound(platform, tolerance, home);
+  for (double x : values[0]) {
+    for (double y : values[1]) {
+      for (double z : values[2]) {
+        Vector6d q = home;
+        q.head<3>() << x, y, z;
+        if (!LegLengthsWithinStroke(platform, InverseKinematics(platform, q))) continue;
+        margin = margin.cwiseMax(PoseErrorBound(platform, tolerance, q));
+      }
+    }
+  }
+  return margin;
+}
 
 ConstraintSet BuildConstraintSet(const PlatformParams& platform, const SafetyConfig& safety) {
   ConstraintSet c;
@@ -33,13 +68,25 @@ ConstraintSet BuildConstraintSet(const PlatformParams& platform, const SafetyCon
     c.position[static_cast<size_t>(c.num_position++)] = {source,  index, sign, limit,
                                                          alpha_e, alpha, name};
   };
+  c.joint_tolerance_margin = JointToleranceMargin(platform, safety);
   for (const PositionLimitConfig& l : safety.position_limits) {
     const std::string axis(kAxisNames[static_cast<size_t>(l.axis)]);
+    const double margin = c.joint_tolerance_margin(l.axis);
+    STEWART_CHECK_INPUT(std::isfinite(margin), "safety.joint_position_tolerance",
+                        "the pose error is unbounded (a singular pose on the limits' grid)");
+    STEWART_CHECK_INPUT(!(l.lower && l.upper) || *l.lower + margin < *l.upper - margin,
+                        "safety.joint_position_tolerance",
+                        "leaves no room between the " + axis + " limits");
+    const double home = safety.home_pose[static_cast<size_t>(l.axis)];
+    STEWART_CHECK_INPUT(
+        !(margin > 0.0) ||
+            ((!l.lower || *l.lower + margin < home) && (!l.upper || home < *l.upper - margin)),
+        "safety.joint_position_tolerance", "draws a " + axis + " limit past the home pose");
     if (l.lower)
-      add_position(PositionSource::kAxis, l.axis, 1.0, *l.lower, l.alpha_e, l.alpha,
+      add_position(PositionSource::kAxis, l.axis, 1.0, *l.lower + margin, l.alpha_e, l.alpha,
                    axis + "_lower");
     if (l.upper)
-      add_position(PositionSource::kAxis, l.axis, -1.0, *l.upper, l.alpha_e, l.alpha,
+      add_position(PositionSource::kAxis, l.axis, -1.0, *l.upper - margin, l.alpha_e, l.alpha,
                    axis + "_upper");
   }
   if (safety.leg_stroke.enabled) {

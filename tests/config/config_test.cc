@@ -3,6 +3,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <functional>
@@ -100,6 +101,29 @@ TEST(Config, CorrectionMetricAndFrictionModel) {
                     "safety.correction_metric", "not one of");
   ExpectConfigError([](YAML::Node& y) { y["controller"]["compensate_friction"] = "yes please"; },
                     "controller.compensate_friction", "true or false");
+}
+
+TEST(Config, JointToleranceAndAccelerometerBiasAxes) {
+  const StackConfig c = LoadStackConfig(DefaultConfigPath());
+  EXPECT_DOUBLE_EQ(c.safety.joint_radius_tolerance_m, 0.001);
+  EXPECT_DOUBLE_EQ(c.safety.joint_angle_tolerance_rad, 0.5 * M_PI / 180.0);
+  EXPECT_EQ(c.safety.home_pose[2], c.home_pose(2));
+  EXPECT_FALSE(c.estimator.estimate_accel_bias_z);
+  YAML::Node yaml = DefaultYaml();
+  yaml["safety"].remove("joint_position_tolerance");  // optional: no margin
+  yaml["estimator"].remove("accel_bias_axes");        // optional: every axis
+  const StackConfig defaults = ParseStackConfig(Emit(yaml));
+  EXPECT_EQ(defaults.safety.joint_radius_tolerance_m, 0.0);
+  EXPECT_EQ(defaults.safety.joint_angle_tolerance_rad, 0.0);
+  EXPECT_TRUE(defaults.estimator.estimate_accel_bias_z);
+  ExpectConfigError(
+      [](YAML::Node& y) { y["safety"]["joint_position_tolerance"]["radius_m"] = -0.001; },
+      "safety.joint_position_tolerance.radius_m", "negative");
+  ExpectConfigError(
+      [](YAML::Node& y) { y["safety"]["joint_position_tolerance"].remove("angle_deg"); },
+      "safety.joint_position_tolerance.angle_deg", "missing");
+  ExpectConfigError([](YAML::Node& y) { y["estimator"]["accel_bias_axes"] = "xz"; },
+                    "estimator.accel_bias_axes", "not one of");
 }
 
 TEST(Config, NotANumber) {

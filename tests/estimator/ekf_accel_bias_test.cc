@@ -31,6 +31,7 @@ BiasRun RunWithBias(const Vector3d& bias_mps2, double initial_bias_std_mps2) {
   StackConfig c = DefaultStackConfig();
   c.estimator.initial_accel_bias_std_mps2 = initial_bias_std_mps2;
   c.estimator.accel_bias_walk_mps2_per_sqrt_s = 1e-4;
+  c.estimator.estimate_accel_bias_z = true;  // a bias on every axis
   Ekf ekf(c.platform, c.actuators, c.sensors, c.estimator, c.home_pose);
   constexpr double kDt = 1e-3;
   constexpr int kArm = 200, kEnd = 3200;

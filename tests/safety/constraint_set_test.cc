@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "safety_test_support.h"
+#include "stewart/model/joint_tolerance.h"
 
 namespace stewart::safety::test {
 namespace {
@@ -44,6 +45,48 @@ TEST(ConstraintSet, RichConfigHasEveryKind) {
   EXPECT_EQ(c.position[8].name, "leg0_lower");
   EXPECT_EQ(c.position[8].source, PositionSource::kLegLength);
   EXPECT_DOUBLE_EQ(c.position[9].limit, DefaultConfig().platform.leg_max_length_m - 0.005);
+}
+
+TEST(ConstraintSet, TheJointToleranceDrawsTheAxisLimitsInByThePoseErrorsWorstCase) {
+  const StackConfig& config = DefaultConfig();
+  SafetyConfig s = config.safety;
+  s.joint_radius_tolerance_m = 0.001;
+  s.joint_angle_tolerance_rad = 0.5 * M_PI / 180.0;
+  const ConstraintSet c = BuildConstraintSet(config.platform, s);
+  const JointTolerance tolerance{0.001, 0.5 * M_PI / 180.0};
+  // The worst pose error on the x limit face is at least the bound there.
+  Vector6d on_x_limit = config.home_pose;
+  on_x_limit(0) = 0.11;
+  const Vector6d there = PoseErrorBound(config.platform, tolerance, on_x_limit);
+  EXPECT_GE(c.joint_tolerance_margin(0), there(0));
+  // Millimetres: the shipped tolerance's figures (docs/safety.md).
+  EXPECT_GT(c.joint_tolerance_margin(0), 0.004);
+  EXPECT_LT(c.joint_tolerance_margin(0), 0.008);
+  EXPECT_GT(c.joint_tolerance_margin(2), 0.0005);
+  EXPECT_LT(c.joint_tolerance_margin(2), 0.003);
+  ASSERT_EQ(c.position[0].name, "x_upper");
+  EXPECT_DOUBLE_EQ(c.position[0].limit, 0.11 - c.joint_tolerance_margin(0));
+  EXPECT_DOUBLE_EQ(c.position[2].limit, 0.51 - c.joint_tolerance_margin(2));
+  // The legs' stroke is measured directly: no margin.
+  EXPECT_DOUBLE_EQ(c.position[4].limit, config.platform.leg_max_length_m - 0.005);
+
+  s.joint_radius_tolerance_m = 0.0;
+  s.joint_angle_tolerance_rad = 0.0;
+  const ConstraintSet exact = BuildConstraintSet(config.platform, s);
+  EXPECT_EQ(exact.joint_tolerance_margin, Vector6d::Zero());
+  EXPECT_DOUBLE_EQ(exact.position[0].limit, 0.11);
+}
+
+TEST(ConstraintSet, AToleranceThatLeavesNoRoomNamesItsKey) {
+  SafetyConfig s = DefaultConfig().safety;
+  s.joint_radius_tolerance_m = 0.05;
+  try {
+    BuildConstraintSet(DefaultConfig().platform, s);
+    FAIL() << "accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("safety.joint_position_tolerance"), std::string::npos)
+        << e.what();
+  }
 }
 
 TEST(ConstraintSet, TooManyLimitsAreRejected) {

@@ -33,6 +33,11 @@ SafetyConfig RichSafetyConfig() {
   // the per-barrier step that may replace its answer is tested on its own
   // (per_barrier_test.cc).
   s.check_each_barrier = false;
+  // The random states are drawn against these limits as written; the joint
+  // tolerance's margin (a constant shift of each limit) has its own tests
+  // (constraint_set_test.cc).
+  s.joint_radius_tolerance_m = 0.0;
+  s.joint_angle_tolerance_rad = 0.0;
   s.position_limits = {
       {0, -0.08, 0.11, 1.0, 1.0},
       {1, -0.10, 0.11, 1.5, 0.8},

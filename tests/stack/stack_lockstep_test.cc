@@ -37,11 +37,14 @@ struct StackCase {
 // paper: x moves to 0.1 m at the 0.015 m/s velocity limit during 0-10 s, then
 // y starts. beyond-limits: x steps to 0.14 m, beyond the 0.11 m limit.
 // With the P-16P legs the platform cruises more slowly (the motors' back-EMF
-// and the 100 N box): ~0.085 m by 12 s.
+// and the 100 N box): ~0.085 m by 12 s. The filter keeps x below 0.1035 m
+// (the 0.11 m limit drawn in for the joints' tolerance, docs/safety.md);
+// beyond-limits must come within 20 mm of that, and with the P-16P legs'
+// rotor mass in the energy barrier's kinetic term it slows from further out.
 const StackCase kCases[] = {{"paper", 7820, 12.0, 0.09},
                             {"beyond-limits", 7821, 12.0, 0.10},
                             {"paper", 7823, 12.0, 0.08, true},
-                            {"beyond-limits", 7824, 12.0, 0.09, true}};
+                            {"beyond-limits", 7824, 12.0, 0.0835, true}};
 
 void PrintTo(const StackCase& c, std::ostream* os) {
   *os << c.scenario << (c.p16p_legs ? " with P-16P legs" : "") << " (" << c.duration_s

@@ -41,6 +41,11 @@ struct EstimatorConfig {
   /// sqrt(s)).
   double initial_accel_bias_std_mps2 = 0.0;
   double accel_bias_walk_mps2_per_sqrt_s = 0.0;
+  /// Optional key `accel_bias_axes: xyz | xy` (default xyz): with xy the
+  /// bias along {P}'s z is held at zero. The tilt a wrong geometry puts
+  /// into the pose shows in x and y; along z a bias shares out a vertical
+  /// force deficit with d (docs/estimator.md, "The accelerometer's bias").
+  bool estimate_accel_bias_z = true;
   /// Multiplies the leg-length variance (noise + ADC quantisation); > 1
   /// absorbs the time correlation of the quantisation error.
   double leg_noise_inflation = 1.6;

@@ -74,6 +74,10 @@ struct ConstraintSet {
   /// composed barrier at about -e / gamma (docs/safety.md "Model error").
   double position_rate_per_s = 1.0;
   double velocity_rate_per_s = 1.0;
+  /// How far each axis position limit was drawn in for the joints'
+  /// tolerance (m, rad): the pose error's worst case over the limit faces
+  /// (JointToleranceMargin). Already in the specs' limits.
+  Vector6d joint_tolerance_margin = Vector6d::Zero();
 };
 
 inline void RecoveryTarget(const VelocityBarrierSpec& s, double h, double* phi, double* dphi_dh) {
@@ -87,6 +91,13 @@ inline void RecoveryTarget(const VelocityBarrierSpec& s, double h, double* phi, 
   *phi = s.recovery_speed * t;
   *dphi_dh = kappa * (1.0 - t * t);
 }
+
+/// The margin the axis position limits keep for the joints' tolerance, per
+/// axis (m, rad): the largest PoseErrorBound over the poses of a grid whose
+/// every translational axis takes its home value and its limits (an axis
+/// with one limit also the limit mirrored about home), at the home attitude,
+/// the poses outside the leg stroke left out. Zero without a tolerance.
+Vector6d JointToleranceMargin(const PlatformParams& platform, const SafetyConfig& safety);
 
 /// Throws InputError (a std::invalid_argument naming the config key) when the
 /// config holds more constraints than the capacity (an axis listed twice) or

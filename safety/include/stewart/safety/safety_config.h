@@ -1,4 +1,5 @@
 #pragma once
+#include <array>
 #include <optional>
 #include <string>
 #include <vector>
@@ -82,6 +83,15 @@ struct SafetyConfig {
   /// attitude error, g * 0.1 mrad = 1 mm/s^2) cannot hold the state outside.
   double velocity_robust_margin_mps2 = 0.0;
   double position_robust_margin_w = 0.0;
+  /// Optional key `joint_position_tolerance: {radius_m, angle_deg}`: how well
+  /// the joint centres are known. The axis position limits are drawn in by
+  /// the worst pose error it allows (model/joint_tolerance.h; docs/safety.md,
+  /// "Joint tolerance"). Stored in m and rad; default 0: no margin.
+  double joint_radius_tolerance_m = 0.0;
+  double joint_angle_tolerance_rad = 0.0;
+  /// The pose the limit faces are sampled around for that margin (the
+  /// config's platform.home_pose, set by ParseStackConfig).
+  std::array<double, 6> home_pose{};
   double leg_friction_nspm = 0.0;
   /// Optional key: kappa of the recovery barriers h_r = sign qd_j + kappa h(q)
   /// of the axis position limits (1/s; docs/safety.md "Outside the safe
