@@ -31,6 +31,17 @@ TEST(TruthLoader, EmptyTruthIsTheConfig) {
   EXPECT_EQ(t.initial_pose, Config().plant_sim.initial_pose);
 }
 
+// The shipped corner truths (config/truths/) load and are the corners.
+TEST(TruthLoader, TheBoundsCornersLoad) {
+  const std::string dir = std::string(STEWART_SOURCE_DIR) + "/config/truths/";
+  const PlantTruth heavy = LoadPlantTruth(Config(), dir + "bounds-heavy-corner.yaml");
+  const PlantTruth light = LoadPlantTruth(Config(), dir + "bounds-light-corner.yaml");
+  EXPECT_GT(heavy.platform.platform_mass_kg, 1.4 * Config().platform.platform_mass_kg);
+  EXPECT_LT(light.platform.platform_mass_kg, 0.85 * Config().platform.platform_mass_kg);
+  EXPECT_NEAR(heavy.latency.total_s(), 0.002, 1e-12);
+  EXPECT_NEAR(light.latency.total_s(), 0.002, 1e-12);
+}
+
 TEST(TruthLoader, OverridesKeyByKeyAndKeepsTheRest) {
   const PlantTruth t = Parse(R"(
 platform: {mass_kg: 0.9}
