@@ -4,7 +4,6 @@
 #include "safety_node.h"
 #include "stewart/node/node_main.h"
 #include "stewart/safety/clp_reference_qp.h"
-#include "stewart/safety/constraint_set.h"
 
 int main(int argc, char** argv) {
   std::string variant;
@@ -37,8 +36,8 @@ int main(int argc, char** argv) {
                      stewart::kSafetyVariantNames.Name(config.safety.variant),
                      config.lcm.channels.command_nominal, config.lcm.channels.command_safe,
                      config.lcm.url);
-        const stewart::Vector6d margin =
-            stewart::safety::JointToleranceMargin(config.platform, config.safety);
+        const stewart::Vector6d& margin =
+            node.process().filter().constraints().joint_tolerance_margin;
         if (margin.head<3>().maxCoeff() > 0.0) {
           spdlog::info(
               "safety: the joints' tolerance draws the position limits in by x {:.1f}, y {:.1f}, "

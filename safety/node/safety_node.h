@@ -40,6 +40,7 @@ class SafetyNode {
   void OnHealth(const lcm::ReceiveBuffer*, const std::string&, const health_t* msg);
 
   int64_t session_id() const { return session_id_; }
+  const safety::SafetyProcess& process() const { return process_; }
   /// Testing only: the safe command numbered `seq` is lost on its way
   /// (TestLoss); its diagnostics go out.
   void LoseCommandForTest(int64_t seq) { loss_.Lose(config_.lcm.channels.command_safe, seq); }

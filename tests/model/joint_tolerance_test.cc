@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <random>
 
 #include "stewart/model/kinematics.h"
@@ -74,6 +75,12 @@ TEST(JointTolerance, NoGeometryWithinTheToleranceMovesTheFittedPoseBeyondTheBoun
       const Vector6d error = FittedPose(nominal, Displaced(nominal, offsets), q) - q;
       largest = largest.cwiseMax(error.cwiseAbs());
     }
+    std::printf(
+        "[joint tolerance] q (%.2f %.2f %.2f): bound x %.2f y %.2f z %.2f mm, tilt %.2f %.2f "
+        "mrad; largest of 2000 draws x %.2f y %.2f z %.2f mm, tilt %.2f %.2f mrad\n",
+        q(0), q(1), q(2), 1e3 * bound(0), 1e3 * bound(1), 1e3 * bound(2), 1e3 * bound(3),
+        1e3 * bound(4), 1e3 * largest(0), 1e3 * largest(1), 1e3 * largest(2), 1e3 * largest(3),
+        1e3 * largest(4));
     // First order: the second-order terms are ~ (r angle)^2 / L, under 1 %.
     for (int a = 0; a < kNumAxes; ++a) {
       EXPECT_LE(largest(a), 1.01 * bound(a)) << "axis " << a << " at " << q.transpose();

@@ -77,7 +77,7 @@ TEST(ConstraintSet, TheJointToleranceDrawsTheAxisLimitsInByThePoseErrorsWorstCas
   EXPECT_DOUBLE_EQ(exact.position[0].limit, 0.11);
 }
 
-TEST(ConstraintSet, AToleranceThatLeavesNoRoomNamesItsKey) {
+TEST(ConstraintSet, AToleranceThatDrawsALimitPastHomeNamesItsKey) {
   SafetyConfig s = DefaultConfig().safety;
   s.joint_radius_tolerance_m = 0.05;
   try {
