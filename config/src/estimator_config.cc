@@ -35,6 +35,9 @@ EstimatorConfig ParseEstimatorConfig(const ConfigNode& estimator) {
   if (estimator.Has("command_latency_s")) {
     e.command_latency_s = estimator.NonNegativeDouble("command_latency_s");
   }
+  if (estimator.Has("command_latency_allowance_s")) {
+    e.command_latency_allowance_s = estimator.NonNegativeDouble("command_latency_allowance_s");
+  }
   e.settle_samples = estimator.IntInRange("settle_samples", 0, INT_MAX, "must not be negative");
   e.max_gyro_radps = estimator.PositiveDouble("max_gyro_radps");
   e.max_accel_mps2 = estimator.PositiveDouble("max_accel_mps2");

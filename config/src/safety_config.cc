@@ -64,6 +64,9 @@ SafetyConfig ParseSafetyConfig(const ConfigNode& safety) {
     if (!(*stop > 0.0)) safety.Fail("stop_time_s", "must be positive");
     s.stop_time_s = *stop;
   }
+  if (safety.Has("drive_on_response_s")) {
+    s.drive_on_response_s = safety.NonNegativeDouble("drive_on_response_s");
+  }
   if (safety.Has("correction_metric")) {
     s.correction_metric = safety.EnumValue("correction_metric", kCorrectionMetricNames);
   }

@@ -215,6 +215,7 @@ void Ekf::Reset() {
   pose_reopened_utime_.reset();
   samples_since_accel_disagreed_ = kNeverDisagreed;
   samples_since_init_ = 0;
+  drive_on_window_ = false;  // a restart keeps its own d
 }
 
 void Ekf::Initialize(int64_t utime, const Vector6d& q, const Vector6d& qd, const EkfVector& std) {
@@ -238,6 +239,7 @@ void Ekf::Initialize(int64_t utime, const Vector6d& q, const Vector6d& qd, const
   pose_reopened_utime_.reset();
   samples_since_accel_disagreed_ = kNeverDisagreed;
   samples_since_init_ = 0;
+  drive_on_window_ = false;  // a restart keeps its own d
 }
 
 bool Ekf::LegsUsable(const SensorSample& sample, uint32_t* events) const {
@@ -323,15 +325,40 @@ void Ekf::Predict(double dt_s, int64_t utime, const EulerAngleTrig& trig, bool d
                                             (actuators_.kind == ActuatorKind::kDcMotor &&
                                              (!command_fresh || command->force_n.isZero())));
   const bool use_dynamics = dynamics_model && command_fresh && !legs_held;
+  if (use_dynamics && legs_were_held_ && config_.estimate_disturbance &&
+      config_.command_latency_allowance_s > 0.0) {
+    // The drive comes on. Until the latency allowance has passed, a sample
+    // may show the legs still held: a platform at rest whatever d is, which
+    // the model would read as d = what balances the command. Pinned within
+    // one sample, such a d held a 0.28 N m payload torque gated for 100 ms,
+    // and the estimate restarted. What those samples say of d is dropped
+    // after each of them: the commands of the window hold with the d of
+    // before, and d is learnt from samples the drive surely acted on.
+    drive_on_window_ = true;
+    drive_on_command_utime_ = command->utime;
+    d_before_drive_on_ = x_.segment<6>(kEkfDisturbance);
+    p_dd_before_drive_on_ = P_.block<6, 6>(kEkfDisturbance, kEkfDisturbance);
+  } else if (!use_dynamics ||
+             (drive_on_window_ && last_utime_ - drive_on_command_utime_ >=
+                                      static_cast<int64_t>(std::llround(
+                                          config_.command_latency_allowance_s / kUsToS)))) {
+    drive_on_window_ = false;
+  }
+  legs_were_held_ = legs_held;
   double sigma_lin = config_.process_accel_std_mps2;
   double sigma_ang = config_.process_angaccel_std_radps2;
   if (use_dynamics) {
+    const bool latency_allowed = config_.command_latency_allowance_s > 0.0;
     DynamicsAccelerationJacobians(params_, leg_damping_nspm_, q, trig, qd, command->force_n,
                                   x_.segment<6>(kEkfDisturbance), &qdd_, &dqdd_dq_, &dqdd_dqd_,
-                                  &m_inv_, shared_terms_.get());
+                                  &m_inv_, shared_terms_.get(),
+                                  latency_allowed ? &dqdd_dforce_ : nullptr);
+    latency_accel_ =
+        latency_allowed ? LatencyAccelerationError(*command, last_utime_, qd) : Vector6d::Zero();
     sigma_lin = config_.dynamics_accel_std_mps2;
     sigma_ang = config_.dynamics_angaccel_std_radps2;
   } else if (legs_held) {
+    latency_accel_.setZero();
     // Held: the motion dies out with the legs' time constant; d takes no part.
     *events |= kEventLegsHeld;
     qdd_ = -qd / hold_time_constant_s_;
@@ -341,6 +368,7 @@ void Ekf::Predict(double dt_s, int64_t utime, const EulerAngleTrig& trig, bool d
     sigma_lin = config_.dynamics_accel_std_mps2;
     sigma_ang = config_.dynamics_angaccel_std_radps2;
   } else {
+    latency_accel_.setZero();
     if (config_.process_model == EstimatorProcessModel::kDynamics) *events |= kEventNoCommand;
     qdd_.setZero();
   }
@@ -389,6 +417,16 @@ void Ekf::Predict(double dt_s, int64_t utime, const EulerAngleTrig& trig, bool d
     AddWhiteAcceleration(i, sigma_lin, dt_s, &P_);
     AddWhiteAcceleration(i + 3, sigma_ang, dt_s, &P_);
   }
+  if (!latency_accel_.isZero()) {
+    // One sample of the acceleration error the latency allowance leaves,
+    // along its direction (as AddWhiteAcceleration, for a vector).
+    const Matrix6d e = latency_accel_ * latency_accel_.transpose();
+    const double dt2 = dt_s * dt_s;
+    P_.block<6, 6>(kEkfQ, kEkfQ) += (0.25 * dt2 * dt2) * e;
+    P_.block<6, 6>(kEkfQ, kEkfQd) += (0.5 * dt2 * dt_s) * e;
+    P_.block<6, 6>(kEkfQd, kEkfQ) += (0.5 * dt2 * dt_s) * e;
+    P_.block<6, 6>(kEkfQd, kEkfQd) += dt2 * e;
+  }
   const double walk = config_.gyro_bias_walk_radps_per_sqrt_s;
   P_.diagonal().segment<3>(kEkfGyroBias).array() += walk * walk * dt_s;
   if (EstimatesAccelBias()) {
@@ -403,6 +441,56 @@ void Ekf::Predict(double dt_s, int64_t utime, const EulerAngleTrig& trig, bool d
     P_.diagonal().segment<3>(kEkfDisturbance).array() += walk_n * walk_n * dt_s;
     P_.diagonal().segment<3>(kEkfDisturbance + 3).array() += walk_nm * walk_nm * dt_s;
   }
+}
+
+void Ekf::RestoreDisturbanceBeforeDriveOn() {
+  x_.segment<6>(kEkfDisturbance) = d_before_drive_on_;
+  P_.middleRows<6>(kEkfDisturbance).setZero();
+  P_.middleCols<6>(kEkfDisturbance).setZero();
+  P_.block<6, 6>(kEkfDisturbance, kEkfDisturbance) = p_dd_before_drive_on_;
+}
+
+Vector6d Ekf::LatencyAccelerationError(const TimedCommand& command, int64_t interval_start_utime,
+                                       const Vector6d& qd) const {
+  // With the actuators' latency anywhere in [command_latency_s,
+  // command_latency_s + allowance], the command acting over the interval is
+  // the model's or one issued before it, back to the one acting at the
+  // allowance's far end. Each differs from the model's prediction by
+  // M^-1 H (F' - F), or, for a command that held the legs (the drive off:
+  // the first samples after the drive comes on), by the held legs' motion
+  // minus the predicted one. Unmodelled, a command that arrived late was
+  // taken as model error d within one sample: 5.4 N learnt for 2.9 N on a
+  // light platform at arming, which then fell at 0.06 m/s (docs/estimator.md,
+  // "Latency allowance").
+  const int64_t far_end_utime =
+      interval_start_utime -
+      static_cast<int64_t>(
+          std::llround((config_.command_latency_s + config_.command_latency_allowance_s) / kUsToS));
+  Vector6d worst = Vector6d::Zero();
+  double worst_norm = 0.0;
+  bool older = false;
+  for (int k = 0; k < command_count_; ++k) {
+    const TimedCommand& c = command_history_[static_cast<size_t>(
+        (command_next_ - 1 - k + kCommandHistory) % kCommandHistory)];
+    if (&c == &command) {
+      older = true;
+      continue;
+    }
+    if (!older) continue;
+    const bool held =
+        c.drive_off || (actuators_.kind == ActuatorKind::kDcMotor && c.force_n.isZero());
+    const Vector6d e = held ? Vector6d(-qd / hold_time_constant_s_ - qdd_)
+                            : Vector6d(dqdd_dforce_ * (c.force_n - command.force_n));
+    const double norm = e.squaredNorm();
+    if (e.allFinite() && norm > worst_norm) {
+      worst = e;
+      worst_norm = norm;
+    }
+    if (c.utime <= far_end_utime) break;
+  }
+  // One of two forces acting, the model's with probability p: the spread
+  // about the model's is sqrt(p (1 - p)) |e| <= |e| / 2.
+  return 0.5 * worst;
 }
 
 template <int M, int NB>
@@ -568,6 +656,9 @@ void Ekf::CorrectAccel(const Vector3d& accel_mps2, const EulerAngleTrig& trig, u
     t.bottomRows<6>().noalias() = dqdd_dqd_.transpose() * d_t;
     const Eigen::Matrix<double, 12, 3> pt = P_.topLeftCorner<12, 12>().lazyProduct(t);
     R.noalias() += t.transpose() * pt;
+    // ... and by the command the actuators may apply instead (Predict).
+    const Vector3d latency = j.d_qdd * latency_accel_;
+    R.noalias() += latency * latency.transpose();
   }
   double nis = 0.0;
   const Vector3d y = accel_mps2 - predicted;
@@ -713,6 +804,8 @@ UpdateResult Ekf::Update(const SensorSample& sample) {
     }
   }
   ++samples_since_init_;
+  // The drive may not act yet (Predict): nothing this sample said of d is kept.
+  if (drive_on_window_) RestoreDisturbanceBeforeDriveOn();
 
   // Divergence: the legs keep disagreeing with the estimate, or the filter
   // arithmetic broke down. Either way restart from the legs.

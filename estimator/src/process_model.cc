@@ -80,8 +80,8 @@ void DynamicsAccelerationJacobians(const PlatformParams& params, double friction
                                    const Vector6d& q, const EulerAngleTrig& trig,
                                    const Vector6d& qd, const Vector6d& force_n,
                                    const Vector6d& disturbance_n, Vector6d* qdd, Matrix6d* dqdd_dq,
-                                   Matrix6d* dqdd_dqd, Matrix6d* m_inv,
-                                   SharedDynamicsTerms* shared) {
+                                   Matrix6d* dqdd_dqd, Matrix6d* m_inv, SharedDynamicsTerms* shared,
+                                   Matrix6d* dqdd_dforce) {
   DynamicsTerms terms;
   EvaluateDynamics(params, shared, q, qd, &terms);
   const Matrix6d& H = terms.H;
@@ -188,6 +188,7 @@ void DynamicsAccelerationJacobians(const PlatformParams& params, double friction
     dqdd_dq->setConstant(NAN);
     dqdd_dqd->setConstant(NAN);
     m_inv->setConstant(NAN);
+    if (dqdd_dforce != nullptr) dqdd_dforce->setConstant(NAN);
     return;
   }
   // 18 columns of derivatives, qdd's right-hand side and a zero column: 20
@@ -204,6 +205,7 @@ void DynamicsAccelerationJacobians(const PlatformParams& params, double friction
   *dqdd_dq = rhs.leftCols<6>();
   *dqdd_dqd = rhs.middleCols<6>(6);
   *m_inv = rhs.middleCols<6>(12);
+  if (dqdd_dforce != nullptr) dqdd_dforce->noalias() = *m_inv * H;
 }
 
 }  // namespace stewart

@@ -91,6 +91,7 @@ SafetyFilter::SafetyFilter(const PlatformParams& platform, const SafetyConfig& s
       force_limit_n_(actuators.force_limit_n),
       fallback_(safety.fallback),
       stop_time_s_(safety.stop_time_s),
+      drive_on_response_s_(safety.drive_on_response_s),
       use_disturbance_(safety.use_disturbance_estimate),
       check_each_barrier_(safety.check_each_barrier),
       nominal_max_accel_(NominalAccelerationBound(safety.sample_period_s,
@@ -106,6 +107,7 @@ SafetyFilter::SafetyFilter(const PlatformParams& platform, const SafetyConfig& s
   STEWART_CHECK_INPUT(force_limit_n_ > 0.0 || !force_limits_, "actuators.force_limit_n",
                       "must be positive when safety.force_limits_enabled");
   STEWART_CHECK_INPUT(stop_time_s_ > 0.0, "safety.stop_time_s", "must be positive");
+  STEWART_CHECK_INPUT(drive_on_response_s_ >= 0.0, "safety.drive_on_response_s", "must be >= 0");
   STEWART_CHECK_INPUT(leg_friction_nspm_ >= 0.0, "safety.leg_friction_nspm", "must be >= 0");
   set_variant(variant_);
 }
@@ -313,6 +315,49 @@ Vector6d SafetyFilter::SafeStopCommand(const Vector6d& q, const Vector6d& qd,
   const bool use_d = use_disturbance_ && disturbance.force_n.allFinite();
   d->f_safe = SafeStop(terms, qd, state_valid, use_d ? disturbance.force_n : kNoDisturbance);
   return d->f_safe;
+}
+
+double SafetyFilter::DriveOnShiftN(const Vector6d& q, const Vector6d& qd,
+                                   const GeneralizedDisturbance& disturbance) {
+  constexpr int kZ = 2;
+  if (!use_disturbance_ || !disturbance.std_n.allFinite() || !q.allFinite() || !qd.allFinite()) {
+    return 0.0;
+  }
+  const VelocityBarrierSpec* limit = nullptr;
+  int sides = 0;
+  for (int i = 0; i < constraints_.num_velocity; ++i) {
+    const VelocityBarrierSpec& s = constraints_.velocity[static_cast<size_t>(i)];
+    if (s.axis != kZ || s.recovery_of >= 0) continue;
+    limit = &s;
+    ++sides;
+  }
+  if (sides != 1) return 0.0;
+  // Answered at once, a lift never builds up: nothing to shift.
+  if (!(drive_on_response_s_ > 0.0)) return 0.0;
+  const double worst_n = constraints_.disturbance_sigma * std::max(disturbance.std_n(kZ), 0.0);
+  double absorbed_n = 0.0;
+  {
+    DynamicsTerms& terms = workspace_.terms;
+    EvaluateDynamics(platform_, shared_terms_.get(), q, qd, &terms);
+    const Eigen::LDLT<Matrix6d> m(terms.M);
+    if (!terms.M.allFinite() || m.info() != Eigen::Success || !m.isPositive()) return 0.0;
+    const double m_inv_zz = m.solve(Vector6d::Unit(kZ))(kZ);
+    if (!(m_inv_zz > 0.0)) return 0.0;
+    // h_v = sign (zd - limit): the room left to the limit (m/s).
+    const double room_mps = std::max(limit->sign * (qd(kZ) - limit->limit), 0.0);
+    absorbed_n = room_mps / drive_on_response_s_ / m_inv_zz;
+  }
+  const double shift = std::max(worst_n - absorbed_n, 0.0);
+  // More d along +z lifts: the worst case of an upper limit.
+  return limit->sign < 0.0 ? shift : -shift;
+}
+
+Vector6d SafetyFilter::DriveOnCommand(const Vector6d& q, const Vector6d& qd,
+                                      const GeneralizedDisturbance& disturbance,
+                                      SafetyDiagnostics* d) {
+  GeneralizedDisturbance worst = disturbance;
+  worst.force_n(2) += DriveOnShiftN(q, qd, disturbance);
+  return SafeStopCommand(q, qd, worst, d);
 }
 
 Vector6d SafetyFilter::SafeStop(const DynamicsTerms& terms, const Vector6d& qd, bool terms_valid,

@@ -244,7 +244,12 @@ SafetyOutput SafetyProcess::Supervise(const StateSample& state, const Vector6d& 
     return Emit(force_n, sample_utime, diagnostics_.flags, 0, mode);
   }
   const GeneralizedDisturbance disturbance{state.disturbance, state.disturbance_std};
-  const Vector6d hold = filter_.SafeStopCommand(state.q, state.qd, disturbance, &hold_diagnostics_);
+  // ARMING starts from the drive-on hold: d was not observable while the
+  // legs were held.
+  const Vector6d hold =
+      mode.state == SupervisorState::kHold
+          ? filter_.SafeStopCommand(state.q, state.qd, disturbance, &hold_diagnostics_)
+          : filter_.DriveOnCommand(state.q, state.qd, disturbance, &hold_diagnostics_);
   if (mode.state == SupervisorState::kHold) {
     counters_->Count("hold_commands");
     SafetyOutput out = Emit(hold, sample_utime, hold_diagnostics_.flags, 0, mode);

@@ -126,6 +126,22 @@ TEST(Config, JointToleranceAndAccelerometerBiasAxes) {
                     "estimator.accel_bias_axes", "not one of");
 }
 
+TEST(Config, DriveOnResponseAndCommandLatencyAllowance) {
+  const StackConfig c = LoadStackConfig(DefaultConfigPath());
+  EXPECT_DOUBLE_EQ(c.safety.drive_on_response_s, 0.003);
+  EXPECT_DOUBLE_EQ(c.estimator.command_latency_allowance_s, 0.002);
+  YAML::Node yaml = DefaultYaml();
+  yaml["safety"].remove("drive_on_response_s");             // optional: the model's hold
+  yaml["estimator"].remove("command_latency_allowance_s");  // optional: none
+  const StackConfig defaults = ParseStackConfig(Emit(yaml));
+  EXPECT_EQ(defaults.safety.drive_on_response_s, 0.0);
+  EXPECT_EQ(defaults.estimator.command_latency_allowance_s, 0.0);
+  ExpectConfigError([](YAML::Node& y) { y["safety"]["drive_on_response_s"] = -0.001; },
+                    "safety.drive_on_response_s", "negative");
+  ExpectConfigError([](YAML::Node& y) { y["estimator"]["command_latency_allowance_s"] = -1.0; },
+                    "estimator.command_latency_allowance_s", "negative");
+}
+
 TEST(Config, NotANumber) {
   ExpectConfigError([](YAML::Node& y) { y["platform"]["mass_kg"] = ".nan"; }, "platform.mass_kg",
                     "finite");

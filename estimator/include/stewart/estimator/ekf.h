@@ -136,6 +136,23 @@ class Ekf {
   int samples_since_accel_disagreed_ = kNeverDisagreed;  ///< gated or jumped
   int64_t accel_disagreement_start_utime_ = 0;  ///< first sample of the latest disagreement
   int samples_since_init_ = 0;
+  /// The drive coming on (see Predict): d and its covariance as they were
+  /// before, restored after every sample until command_latency_allowance_s
+  /// has passed.
+  bool legs_were_held_ = false;
+  bool drive_on_window_ = false;
+  int64_t drive_on_command_utime_ = 0;
+  Vector6d d_before_drive_on_ = Vector6d::Zero();
+  Matrix6d p_dd_before_drive_on_ = Matrix6d::Zero();
+  void RestoreDisturbanceBeforeDriveOn();
+  /// See Predict: the acceleration the model's command may be off by over
+  /// the latest interval, from the command latency allowance (1/s^2 per axis).
+  Vector6d latency_accel_ = Vector6d::Zero();
+  Matrix6d dqdd_dforce_ = Matrix6d::Zero();
+  /// The largest such error among the commands that may act instead of the
+  /// model's `command` over the interval starting at `interval_start_utime`.
+  Vector6d LatencyAccelerationError(const TimedCommand& command, int64_t interval_start_utime,
+                                    const Vector6d& qd) const;
   bool diverged_ = false;
   double last_leg_nis_ = 0.0;
 };

@@ -60,6 +60,12 @@ struct EstimatorConfig {
   /// derives from (s): the model applies the command issued that long before
   /// each predicted interval. At most 15 samples (the history kept).
   double command_latency_s = 0.0;
+  /// Optional key: the latest the actuators may act after that (s), an
+  /// allowance for latency the model does not know. After the drive comes
+  /// on, what the samples of this window say of the model error d is
+  /// dropped: they may show the legs still held (docs/estimator.md,
+  /// "Drive-on"). 0: no window.
+  double command_latency_allowance_s = 0.0;
   int settle_samples = 200;          ///< STATUS_INITIALIZING after (re)init
   double max_gyro_radps = 35.0;      ///< larger readings are rejected
   double max_accel_mps2 = 160.0;     ///< larger readings are rejected

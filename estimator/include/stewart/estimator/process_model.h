@@ -37,12 +37,13 @@ void DynamicsAccelerationJacobians(const PlatformParams& params, double friction
 /// `m_inv`. d is constant in q, so the other Jacobians are those above (the
 /// inertial part -M^-1 dM/dq qdd, which d enters, is left out as there).
 /// `shared`: the model terms through it when not null (its parameters are
-/// `params`: AttachSharedTerms).
+/// `params`: AttachSharedTerms). `dqdd_dforce`, when not null: M^-1 H.
 void DynamicsAccelerationJacobians(const PlatformParams& params, double friction_nspm,
                                    const Vector6d& q, const EulerAngleTrig& trig,
                                    const Vector6d& qd, const Vector6d& force_n,
                                    const Vector6d& disturbance_n, Vector6d* qdd, Matrix6d* dqdd_dq,
                                    Matrix6d* dqdd_dqd, Matrix6d* m_inv,
-                                   SharedDynamicsTerms* shared = nullptr);
+                                   SharedDynamicsTerms* shared = nullptr,
+                                   Matrix6d* dqdd_dforce = nullptr);
 
 }  // namespace stewart

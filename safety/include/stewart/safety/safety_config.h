@@ -117,6 +117,13 @@ struct SafetyConfig {
   /// The plant's zero-order-hold period T (s): 1 / sensors.rate_hz, set by
   /// ParseStackConfig. 0 (a config built in code) turns the bound off.
   double sample_period_s = 0.0;
+  /// Optional key: how long a lift at drive-on goes unanswered (s): the
+  /// sample period plus the actuators' latency the stack allows for. The
+  /// drive-on hold (SafetyFilter::DriveOnCommand) lets the worst vertical
+  /// model error reach the z velocity limit in this time, not sooner; 0 (a
+  /// lift answered at once) leaves the hold as the model's (docs/safety.md,
+  /// "Drive-on").
+  double drive_on_response_s = 0.0;
   /// Optional key `check_each_barrier` (default true), variants closed_form
   /// and qp: the composed answer is checked against every barrier's own
   /// condition, and where it breaks one the un-composed QP answers that step

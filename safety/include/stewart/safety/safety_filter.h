@@ -93,6 +93,28 @@ class SafetyFilter {
                            const GeneralizedDisturbance& disturbance,
                            SafetyDiagnostics* diagnostics);
 
+  /// The safe stop when the drive comes on (the supervisor's ARMING starts
+  /// from it). While the legs were held nothing showed the estimator what
+  /// the platform weighs: d_z may be anywhere within safety.disturbance_sigma
+  /// standard deviations of its estimate. The hold is computed with d_z
+  /// shifted towards the configured z velocity limit (up for an upper
+  /// limit) by as much of k sigma_z as the limit cannot absorb within
+  /// safety.drive_on_response_s:
+  ///   shift = max(0, k sigma_z - m_z (zd_max - zd) / T),  m_z = 1 / (M^-1)_zz,
+  /// so a platform lighter than the model reaches at most the limit before
+  /// the estimate sees it move, and sinks rather than lifts when far
+  /// lighter (docs/safety.md, "Drive-on"). Once the estimate has seen the
+  /// platform move, sigma_z is small and this is SafeStopCommand. No shift
+  /// when z has velocity limits on both sides or none, without the
+  /// disturbance estimate, or with T = 0. Diagnostics as SafeStopCommand's.
+  Vector6d DriveOnCommand(const Vector6d& q, const Vector6d& qd,
+                          const GeneralizedDisturbance& disturbance,
+                          SafetyDiagnostics* diagnostics);
+  /// The shift DriveOnCommand adds to d^_z at (q, qd) (N, signed; 0 when
+  /// none applies or the model terms are not usable).
+  double DriveOnShiftN(const Vector6d& q, const Vector6d& qd,
+                       const GeneralizedDisturbance& disturbance);
+
   /// T of the correction metric at these model terms (docs/safety.md): with
   /// F = T y the cost (F - F_des)^T W (F - F_des) is ||y - y_des||^2, and
   /// W^-1 = T T^T. Identity for the force metric; H^-1 L_M (M = L_M L_M^T)
@@ -213,6 +235,7 @@ class SafetyFilter {
   double force_limit_n_;
   SafetyFallback fallback_;
   double stop_time_s_;
+  double drive_on_response_s_;
   bool use_disturbance_;
   bool check_each_barrier_;
   Vector6d nominal_max_accel_;
