@@ -1,5 +1,6 @@
 // Time per EKF update (predict + leg, gyro and accelerometer corrections) at
-// a moving state, for both process models.
+// a moving state, for both process models; and with a command that changes
+// every sample (the latency allowance's noise then acts every update).
 #include <benchmark/benchmark.h>
 
 #include <cmath>
@@ -12,7 +13,8 @@
 
 namespace {
 
-void BM_EkfUpdate(benchmark::State& state, stewart::EstimatorProcessModel model) {
+void BM_EkfUpdate(benchmark::State& state, stewart::EstimatorProcessModel model,
+                  bool changing_command = false) {
   using namespace stewart;
   StackConfig c = LoadStackConfig(DefaultConfigPath());
   c.estimator.process_model = model;
@@ -31,7 +33,9 @@ void BM_EkfUpdate(benchmark::State& state, stewart::EstimatorProcessModel model)
   int64_t utime = 0;
   for (auto _ : state) {
     utime += 1000;
-    ekf.SetForceCommand(utime - 1000, force);
+    // +-0.05 N per leg about the hover force, alternating.
+    const double dither_n = changing_command ? ((utime / 1000) % 2 == 0 ? 0.05 : -0.05) : 0.0;
+    ekf.SetForceCommand(utime - 1000, force + Vector6d::Constant(dither_n));
     s.utime = utime;
     benchmark::DoNotOptimize(ekf.Update(s));
     // Keep the filter near the (stationary) readings: re-seed occasionally
@@ -41,6 +45,8 @@ void BM_EkfUpdate(benchmark::State& state, stewart::EstimatorProcessModel model)
 }
 
 BENCHMARK_CAPTURE(BM_EkfUpdate, dynamics, stewart::EstimatorProcessModel::kDynamics);
+BENCHMARK_CAPTURE(BM_EkfUpdate, dynamics_changing_command,
+                  stewart::EstimatorProcessModel::kDynamics, true);
 BENCHMARK_CAPTURE(BM_EkfUpdate, constant_velocity,
                   stewart::EstimatorProcessModel::kConstantVelocity);
 
