@@ -290,6 +290,13 @@ TEST(LcmReceiver, SubscribeAllTakesEveryChannelWithKernelArrivalTimes) {
   });
   EXPECT_FALSE(receiver.kernel_filter_attached());
   auto lcm = MakeLcm(url);
+  // Linux turns its receive timestamps on for the whole host when the first
+  // socket asks (SO_TIMESTAMP), from a deferred work item: a datagram that
+  // arrives before it has run carries no time, and recvmsg stamps it with the
+  // time of the read. On an otherwise idle host the first run failed that
+  // way now and then (2 of 5 runs 3 s apart; none back to back). A moment
+  // for the kernel, then the measured datagrams.
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));
   const int64_t before = WallUtimeNow();
   force_command_t command{};
   lcm->publish("A", &command);
