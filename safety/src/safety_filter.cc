@@ -298,29 +298,43 @@ Vector6d SafetyFilter::SafeStopCommand(const Vector6d& q, const Vector6d& qd,
   return SafeStopCommand(q, qd, GeneralizedDisturbance{}, d);
 }
 
+bool SafetyFilter::EvaluateSafeStopTerms(const Vector6d& q, const Vector6d& qd) {
+  if (!q.allFinite() || !qd.allFinite()) return false;
+  DynamicsTerms& terms = workspace_.terms;
+  EvaluateDynamics(platform_, shared_terms_.get(), q, qd, &terms);
+  return terms.M.allFinite() && PoseProblems(platform_, q, terms.leg_length_m) == kPosePlausible;
+}
+
 Vector6d SafetyFilter::SafeStopCommand(const Vector6d& q, const Vector6d& qd,
                                        const GeneralizedDisturbance& disturbance,
                                        SafetyDiagnostics* d) {
+  return SafeStopWithShift(EvaluateSafeStopTerms(q, qd), qd, disturbance, 0.0, d);
+}
+
+Vector6d SafetyFilter::SafeStopWithShift(bool terms_valid, const Vector6d& qd,
+                                         const GeneralizedDisturbance& disturbance,
+                                         double shift_z_n, SafetyDiagnostics* d) const {
   *d = SafetyDiagnostics{};
   d->variant = variant_;
-  DynamicsTerms& terms = workspace_.terms;
-  bool state_valid = q.allFinite() && qd.allFinite();
-  if (state_valid) {
-    EvaluateDynamics(platform_, shared_terms_.get(), q, qd, &terms);
-    state_valid =
-        terms.M.allFinite() && PoseProblems(platform_, q, terms.leg_length_m) == kPosePlausible;
-  }
   d->filter_case = FilterCase::kFallback;
   d->flags = kFlagFallback;
   const bool use_d = use_disturbance_ && disturbance.force_n.allFinite();
-  d->f_safe = SafeStop(terms, qd, state_valid, use_d ? disturbance.force_n : kNoDisturbance);
+  Vector6d d_n = use_d ? disturbance.force_n : kNoDisturbance;
+  if (use_d) d_n(2) += shift_z_n;
+  d->f_safe = SafeStop(workspace_.terms, qd, terms_valid, d_n);
   return d->f_safe;
 }
 
 double SafetyFilter::DriveOnShiftN(const Vector6d& q, const Vector6d& qd,
                                    const GeneralizedDisturbance& disturbance) {
+  return EvaluateSafeStopTerms(q, qd) ? DriveOnShift(workspace_.terms, qd, disturbance) : 0.0;
+}
+
+double SafetyFilter::DriveOnShift(const DynamicsTerms& terms, const Vector6d& qd,
+                                  const GeneralizedDisturbance& disturbance) const {
   constexpr int kZ = 2;
-  if (!use_disturbance_ || !disturbance.std_n.allFinite() || !q.allFinite() || !qd.allFinite()) {
+  // Answered at once, a lift never builds up: nothing to shift.
+  if (!use_disturbance_ || !(drive_on_response_s_ > 0.0) || !disturbance.std_n.allFinite()) {
     return 0.0;
   }
   const VelocityBarrierSpec* limit = nullptr;
@@ -332,21 +346,14 @@ double SafetyFilter::DriveOnShiftN(const Vector6d& q, const Vector6d& qd,
     ++sides;
   }
   if (sides != 1) return 0.0;
-  // Answered at once, a lift never builds up: nothing to shift.
-  if (!(drive_on_response_s_ > 0.0)) return 0.0;
+  Cholesky6 inertia;
+  if (!inertia.Compute(terms.M)) return 0.0;
+  const double m_inv_zz = inertia.Solve<1>(Vector6d::Unit(kZ))(kZ);
+  if (!(m_inv_zz > 0.0)) return 0.0;
   const double worst_n = constraints_.disturbance_sigma * std::max(disturbance.std_n(kZ), 0.0);
-  double absorbed_n = 0.0;
-  {
-    DynamicsTerms& terms = workspace_.terms;
-    EvaluateDynamics(platform_, shared_terms_.get(), q, qd, &terms);
-    const Eigen::LDLT<Matrix6d> m(terms.M);
-    if (!terms.M.allFinite() || m.info() != Eigen::Success || !m.isPositive()) return 0.0;
-    const double m_inv_zz = m.solve(Vector6d::Unit(kZ))(kZ);
-    if (!(m_inv_zz > 0.0)) return 0.0;
-    // h_v = sign (zd - limit): the room left to the limit (m/s).
-    const double room_mps = std::max(limit->sign * (qd(kZ) - limit->limit), 0.0);
-    absorbed_n = room_mps / drive_on_response_s_ / m_inv_zz;
-  }
+  // h_v = sign (zd - limit): the room left to the limit (m/s).
+  const double room_mps = std::max(limit->sign * (qd(kZ) - limit->limit), 0.0);
+  const double absorbed_n = room_mps / drive_on_response_s_ / m_inv_zz;
   const double shift = std::max(worst_n - absorbed_n, 0.0);
   // More d along +z lifts: the worst case of an upper limit.
   return limit->sign < 0.0 ? shift : -shift;
@@ -355,9 +362,9 @@ double SafetyFilter::DriveOnShiftN(const Vector6d& q, const Vector6d& qd,
 Vector6d SafetyFilter::DriveOnCommand(const Vector6d& q, const Vector6d& qd,
                                       const GeneralizedDisturbance& disturbance,
                                       SafetyDiagnostics* d) {
-  GeneralizedDisturbance worst = disturbance;
-  worst.force_n(2) += DriveOnShiftN(q, qd, disturbance);
-  return SafeStopCommand(q, qd, worst, d);
+  const bool valid = EvaluateSafeStopTerms(q, qd);
+  const double shift = valid ? DriveOnShift(workspace_.terms, qd, disturbance) : 0.0;
+  return SafeStopWithShift(valid, qd, disturbance, shift, d);
 }
 
 Vector6d SafetyFilter::SafeStop(const DynamicsTerms& terms, const Vector6d& qd, bool terms_valid,

@@ -20,6 +20,30 @@
 namespace stewart {
 namespace {
 
+// The vertical truth both arming runs share: held at home until it moves,
+// then z accelerates as each step says; the sample the EKF gets at step k
+// (drive off before `arm`).
+struct VerticalTruth {
+  Vector6d q;
+  double zd = 0.0;
+  double zdd = 0.0;
+  void Step(bool moving, double zdd_mps2, double dt_s) {
+    zdd = moving ? zdd_mps2 : 0.0;
+    if (!moving) return;
+    q(2) += zd * dt_s + 0.5 * zdd * dt_s * dt_s;
+    zd += zdd * dt_s;
+  }
+  SensorSample Sample(const StackConfig& c, int k, int arm) const {
+    SensorSample s;
+    s.utime = 1'000'000 + 1000 * static_cast<int64_t>(k);
+    s.drive_off = k < arm;
+    s.leg_length_m = InverseKinematics(c.platform, q);
+    s.accel_mps2 = Vector3d(0.0, 0.0, c.platform.gravity_mps2 + zdd);
+    s.gyro_radps = c.sensors.gyro_bias_radps;
+    return s;
+  }
+};
+
 struct ArmingRun {
   int divergences = 0;
   int pose_reopened = 0;
@@ -42,30 +66,20 @@ ArmingRun Arm(double deficit_mps2, int latency_samples) {
   constexpr double kDt = 1e-3, kTau = 0.012;
   // 0.4 s of sinking: up to 24 mm, inside the legs' stroke.
   constexpr int kArm = 200, kEnd = 600;
-  Vector6d q = c.home_pose;
-  double zd = 0.0;
+  VerticalTruth truth{c.home_pose};
   ArmingRun run;
   for (int k = 0; k < kEnd; ++k) {
-    double zdd = 0.0;
-    if (k > kArm + latency_samples) {
-      zdd = -deficit_mps2 - zd / kTau;
-      q(2) += zd * kDt + 0.5 * zdd * kDt * kDt;
-      zd += zdd * kDt;
-    }
-    SensorSample s;
-    s.utime = 1'000'000 + 1000 * static_cast<int64_t>(k);
-    s.drive_off = k < kArm;
-    s.leg_length_m = InverseKinematics(c.platform, q);
-    s.accel_mps2 = Vector3d(0.0, 0.0, c.platform.gravity_mps2 + zdd);
-    s.gyro_radps = c.sensors.gyro_bias_radps;
+    truth.Step(k > kArm + latency_samples, -deficit_mps2 - truth.zd / kTau, kDt);
+    const SensorSample s = truth.Sample(c, k, kArm);
     const UpdateResult r = ekf.Update(s);
     if (r.Has(kEventDiverged)) ++run.divergences;
     if (r.Has(kEventPoseReopened)) ++run.pose_reopened;
     ekf.SetForceCommand(s.utime, k < kArm ? Vector6d::Zero() : hover_n, k < kArm);
     if (k > kArm + 100 && r.has_estimate) {
-      run.worst_z_error_m = std::max(run.worst_z_error_m, std::abs(ekf.estimate().q(2) - q(2)));
+      run.worst_z_error_m =
+          std::max(run.worst_z_error_m, std::abs(ekf.estimate().q(2) - truth.q(2)));
       run.worst_zd_error_mps =
-          std::max(run.worst_zd_error_mps, std::abs(ekf.estimate().qd(2) - zd));
+          std::max(run.worst_zd_error_mps, std::abs(ekf.estimate().qd(2) - truth.zd));
     }
   }
   std::printf(
@@ -106,22 +120,11 @@ DriveOnRun ArmLate(double allowance_s, double surplus_mps2) {
       EvaluateDynamics(c.platform, c.home_pose, Vector6d::Zero()), Vector6d::Zero());
   constexpr double kDt = 1e-3, kTau = 0.012;
   constexpr int kArm = 200, kLatency = 2, kEnd = 400;
-  Vector6d q = c.home_pose;
-  double zd = 0.0;
+  VerticalTruth truth{c.home_pose};
   DriveOnRun run;
   for (int k = 0; k < kEnd; ++k) {
-    double zdd = 0.0;
-    if (k > kArm + kLatency) {
-      zdd = surplus_mps2 - zd / kTau;
-      q(2) += zd * kDt + 0.5 * zdd * kDt * kDt;
-      zd += zdd * kDt;
-    }
-    SensorSample s;
-    s.utime = 1'000'000 + 1000 * static_cast<int64_t>(k);
-    s.drive_off = k < kArm;
-    s.leg_length_m = InverseKinematics(c.platform, q);
-    s.accel_mps2 = Vector3d(0.0, 0.0, c.platform.gravity_mps2 + zdd);
-    s.gyro_radps = c.sensors.gyro_bias_radps;
+    truth.Step(k > kArm + kLatency, surplus_mps2 - truth.zd / kTau, kDt);
+    const SensorSample s = truth.Sample(c, k, kArm);
     const UpdateResult r = ekf.Update(s);
     if (r.Has(kEventDiverged)) ++run.divergences;
     ekf.SetForceCommand(s.utime, k < kArm ? Vector6d::Zero() : hover_n, k < kArm);

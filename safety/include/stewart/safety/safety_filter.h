@@ -183,6 +183,16 @@ class SafetyFilter {
     const Vector6d& disturbance_n;  ///< d the safe stop holds against (0 if unused)
   };
 
+  /// The model terms at (q, qd) into workspace_.terms; false when the state
+  /// is not finite, M is not, or the pose is not plausible.
+  bool EvaluateSafeStopTerms(const Vector6d& q, const Vector6d& qd);
+  /// The safe stop at workspace_.terms against d with `shift_z_n` added to
+  /// its z row, with its diagnostics.
+  Vector6d SafeStopWithShift(bool terms_valid, const Vector6d& qd,
+                             const GeneralizedDisturbance& disturbance, double shift_z_n,
+                             SafetyDiagnostics* d) const;
+  double DriveOnShift(const DynamicsTerms& terms, const Vector6d& qd,
+                      const GeneralizedDisturbance& disturbance) const;
   Vector6d SafeStop(const DynamicsTerms& terms, const Vector6d& qd, bool terms_valid,
                     const Vector6d& disturbance_n) const;
   /// The safe stop as the answer of a step whose QP has no solution.
