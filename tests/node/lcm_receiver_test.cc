@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 #include <netinet/in.h>
 #include <poll.h>
+#include <sys/resource.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
@@ -415,6 +416,14 @@ TEST(LcmReceiver, CountsHostileDatagramsAndKeepsWorking) {
   EXPECT_EQ(receiver.counters().orphan_fragments, 1);
 }
 
+// Minor page faults this thread has taken: pages it touched for the first
+// time. Counted by the kernel, so the same on an idle and on a loaded host.
+int64_t ThreadMinorFaults() {
+  rusage usage{};
+  getrusage(RUSAGE_THREAD, &usage);
+  return usage.ru_minflt;
+}
+
 // A flood of first fragments, each declaring a 16 MiB message (1000 per
 // second for 2 s, on a subscribed and on an unsubscribed channel), while good
 // messages keep coming every 10 ms: no call to HandleTimeout may hold the
@@ -451,23 +460,40 @@ TEST(LcmReceiver, AFloodOfHugeFragmentsNeitherStallsTheLoopNorLosesGoodMessages)
     }
     sending = false;
   });
-  double longest_call_ms = 0.0;
+  // What a call costs its caller is the memory it writes: zeroing a
+  // declared 16 MiB is 4096 fresh pages, each a page fault the kernel
+  // counts. (Its time is shown, not asserted: on a loaded or virtualised
+  // host both its wall and its CPU time hold the host's stalls, 20-30 ms.)
+  int64_t most_faults_in_a_call = 0;
+  double longest_call_wall_ms = 0.0;
+  const int64_t faults_before = ThreadMinorFaults();
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(20);
   while ((sending || sink.seqs.size() < kGoodMessages) &&
          std::chrono::steady_clock::now() < deadline) {
+    const int64_t faults0 = ThreadMinorFaults();
     const auto t0 = std::chrono::steady_clock::now();
     receiver.HandleTimeout(5);
-    const double ms =
+    const double wall_ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-    longest_call_ms = std::max(longest_call_ms, ms);
+    most_faults_in_a_call = std::max(most_faults_in_a_call, ThreadMinorFaults() - faults0);
+    longest_call_wall_ms = std::max(longest_call_wall_ms, wall_ms);
   }
+  const int64_t faults_in_flood = ThreadMinorFaults() - faults_before;
   sender.join();
-  std::printf("[flood] longest HandleTimeout(5 ms) call %.1f ms; good %zu/%d; incomplete %lld\n",
-              longest_call_ms, sink.seqs.size(), kGoodMessages,
-              static_cast<long long>(receiver.counters().incomplete_fragmented));
+  std::printf(
+      "[flood] HandleTimeout(5 ms) calls: at most %lld page faults in one, %lld in all; longest "
+      "%.1f ms of wall time; good %zu/%d; incomplete %lld\n",
+      static_cast<long long>(most_faults_in_a_call), static_cast<long long>(faults_in_flood),
+      longest_call_wall_ms, sink.seqs.size(), kGoodMessages,
+      static_cast<long long>(receiver.counters().incomplete_fragmented));
   EXPECT_EQ(sink.seqs.size(), static_cast<size_t>(kGoodMessages));
-  // A control loop at 1 kHz must get its thread back within a few periods.
-  EXPECT_LT(longest_call_ms, 25.0);
+  // A control loop must get its thread back within a few periods: no call
+  // may write even one declared message's worth of memory (4096 pages), nor
+  // the whole flood more than what its fragments carry (1000 x 1200 bytes:
+  // 293 pages).
+  constexpr int64_t kPagesInADeclaredMessage = kDeclaredBytes / 4096;
+  EXPECT_LT(most_faults_in_a_call, kPagesInADeclaredMessage / 16);
+  EXPECT_LT(faults_in_flood, kPagesInADeclaredMessage / 4);
   // Every flooded message that started a reassembly was given up, counted.
   EXPECT_GT(receiver.counters().incomplete_fragmented, 0);
 }
