@@ -54,6 +54,9 @@ EstimatorConfig ParseEstimatorConfig(const ConfigNode& estimator) {
     e.disturbance_jump_std_nm = d.NonNegativeDouble("jump_std_nm");
     e.disturbance_jump_after_samples =
         d.IntInRange("jump_after_samples", 1, INT_MAX, "must be >= 1");
+    if (d.Has("force_change_std")) {
+      e.disturbance_force_change_std = d.NonNegativeDouble("force_change_std");
+    }
     if (e.estimate_disturbance && e.process_model != EstimatorProcessModel::kDynamics) {
       d.Fail("enabled", "needs estimator.process_model: dynamics (d acts through the dynamics)");
     }

@@ -131,6 +131,7 @@ bool EstimatorProcess::Update(const SensorSample& sample, StateSample* out,
     acceptor_->OnSamplePublished(sample.utime);
   }
   const UpdateResult result = ekf_.Update(sample);
+  last_update_events_ = result.events;
   if (result.Has(kRejectTime)) {
     time_check_.SourceRejected(sample.utime, receive_wall_us);
   } else {

@@ -81,10 +81,11 @@ void DynamicsAccelerationJacobians(const PlatformParams& params, double friction
                                    const Vector6d& qd, const Vector6d& force_n,
                                    const Vector6d& disturbance_n, Vector6d* qdd, Matrix6d* dqdd_dq,
                                    Matrix6d* dqdd_dqd, Matrix6d* m_inv, SharedDynamicsTerms* shared,
-                                   Matrix6d* dqdd_dforce) {
+                                   Matrix6d* dqdd_dforce, Matrix6d* h) {
   DynamicsTerms terms;
   EvaluateDynamics(params, shared, q, qd, &terms);
   const Matrix6d& H = terms.H;
+  if (h != nullptr) *h = H;
   const Vector6d leg_speed_mps = H.transpose() * qd;
   const Vector6d force = force_n - friction_nspm * leg_speed_mps;
 

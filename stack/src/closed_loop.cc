@@ -132,7 +132,7 @@ ClosedLoopSummary RunClosedLoop(const StackConfig& config, const Scenario& scena
     *csv << ",case,h_pos,h_vel";
     for (const char* prefix : {"dest_", "dstd_"})
       for (const std::string_view a : kAxisNames) *csv << ',' << prefix << a;
-    *csv << ",psi_v\n";
+    *csv << ",psi_v,ekf_events\n";
   }
   Vector6d f_safe = Vector6d::Zero();  // held by the plant until the next command
   for (long k = 0; k < ticks; ++k) {
@@ -240,7 +240,7 @@ ClosedLoopSummary RunClosedLoop(const StackConfig& config, const Scenario& scena
            << (d ? d->barriers.h_pos : 0.0) << ',' << (d ? d->barriers.h_vel : 0.0);
       for (const Vector6d* v : {&state.disturbance, &state.disturbance_std})
         for (int i = 0; i < 6; ++i) *csv << ',' << (*v)(i);
-      *csv << ',' << (d ? d->barriers.psi_v : 0.0) << '\n';
+      *csv << ',' << (d ? d->barriers.psi_v : 0.0) << ',' << estimator.last_update_events() << '\n';
     }
     if (!advance(f_safe)) break;
     const Vector6d q1 = plant.q(), qd1 = plant.qd();

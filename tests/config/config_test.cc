@@ -142,6 +142,16 @@ TEST(Config, DriveOnResponseAndCommandLatencyAllowance) {
                     "estimator.command_latency_allowance_s", "negative");
 }
 
+TEST(Config, ForceChangeAllowance) {
+  const StackConfig c = LoadStackConfig(DefaultConfigPath());
+  EXPECT_DOUBLE_EQ(c.estimator.disturbance_force_change_std, 0.1);
+  YAML::Node yaml = DefaultYaml();
+  yaml["estimator"]["disturbance"].remove("force_change_std");  // optional: none
+  EXPECT_EQ(ParseStackConfig(Emit(yaml)).estimator.disturbance_force_change_std, 0.0);
+  ExpectConfigError([](YAML::Node& y) { y["estimator"]["disturbance"]["force_change_std"] = -0.1; },
+                    "estimator.disturbance.force_change_std", "negative");
+}
+
 TEST(Config, NotANumber) {
   ExpectConfigError([](YAML::Node& y) { y["platform"]["mass_kg"] = ".nan"; }, "platform.mass_kg",
                     "finite");

@@ -131,9 +131,11 @@ struct LostRealRun {
 };
 
 void RunWithLostReals(bool lose_reals, double guard_force_limit_n, LostRealRun* run,
-                      std::optional<double> latency_allowance_s = std::nullopt) {
+                      std::optional<double> latency_allowance_s = std::nullopt,
+                      std::optional<double> force_change_std = std::nullopt) {
   StackConfig c = DefaultStackConfig();
   if (latency_allowance_s) c.estimator.command_latency_allowance_s = *latency_allowance_s;
+  if (force_change_std) c.estimator.disturbance_force_change_std = *force_change_std;
   test::ScenarioTruth truth(c, 3);
   EstimatorProcess process(c.platform, c.actuators, c.sensors, c.estimator, c.home_pose,
                            &run->counters, c.lcm.time_plausibility,
@@ -174,12 +176,22 @@ TEST(EstimatorTrust, AForceBeyondTheGuardIsTakenAsDriveOffNotBelieved) {
   }
   // The before: the estimator believed 1e300 N (its force limit) for those
   // samples, and took the commands as acting when issued. (The latency
-  // allowance, docs/estimator.md, now also takes a one-sample spike as a
-  // command that may not act: believing it, the estimate still holds.)
-  LostRealRun believing_with_allowance;
-  RunWithLostReals(true, std::numeric_limits<double>::infinity(), &believing_with_allowance);
-  EXPECT_EQ(believing_with_allowance.restarts, clean.restarts);
-  RunWithLostReals(true, std::numeric_limits<double>::infinity(), &believing, 0.0);
+  // allowance alone, docs/estimator.md, takes a one-sample spike as a
+  // command that may not act: believing it, the estimate holds. The
+  // force-change allowance then widens d by a tenth of the 100 N step and
+  // back: believing that, the estimate restarts; the guard is what keeps
+  // such commands out.)
+  LostRealRun believing_with_latency_allowance, believing_with_both;
+  RunWithLostReals(true, std::numeric_limits<double>::infinity(), &believing_with_latency_allowance,
+                   std::nullopt, 0.0);
+  EXPECT_EQ(believing_with_latency_allowance.restarts, clean.restarts);
+  RunWithLostReals(true, std::numeric_limits<double>::infinity(), &believing_with_both);
+  std::printf(
+      "[lost-real] believing with the latency allowance: %lld restarts; with both "
+      "allowances: %lld\n",
+      static_cast<long long>(believing_with_latency_allowance.restarts),
+      static_cast<long long>(believing_with_both.restarts));
+  RunWithLostReals(true, std::numeric_limits<double>::infinity(), &believing, 0.0, 0.0);
   size_t believing_finite = 0;
   double believing_error_m = 0.0;
   for (size_t i = 0; i < std::min(believing.estimates.size(), clean.estimates.size()); ++i) {

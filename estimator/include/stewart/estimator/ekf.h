@@ -149,6 +149,11 @@ class Ekf {
   /// the latest interval, from the command latency allowance (1/s^2 per axis).
   Vector6d latency_accel_ = Vector6d::Zero();
   Matrix6d dqdd_dforce_ = Matrix6d::Zero();
+  /// See Predict (disturbance_force_change_std): H at the last predict, and
+  /// the force the model applied over the previous interval (absent when
+  /// the legs were held or no command acted).
+  Matrix6d h_ = Matrix6d::Zero();
+  std::optional<Vector6d> previous_model_force_n_;
   /// The largest such error among the commands that may act instead of the
   /// model's `command` over the interval starting at `interval_start_utime`.
   Vector6d LatencyAccelerationError(const TimedCommand& command, int64_t interval_start_utime,

@@ -31,6 +31,13 @@ struct EstimatorConfig {
   double disturbance_jump_std_nm = 0.5;
   /// Consecutive gated accelerometer samples that make a jump.
   int disturbance_jump_after_samples = 5;
+  /// Relative std of what a change of the leg forces changes in d: d holds
+  /// (M - M_true) qdd + H diag(gain - 1) F + ..., so an inertia the model
+  /// lacks (a payload, its offset) and the legs' force gains move d with
+  /// every change of the command, at once, faster than d's walk. Each
+  /// predict adds H diag((std dF_i)^2) H^T to d's covariance, dF the change
+  /// of the command acting since the previous interval (N). 0: off.
+  double disturbance_force_change_std = 0.0;
   /// Random walk of the gyro bias (rad/s per sqrt(s)).
   double gyro_bias_walk_radps_per_sqrt_s = 1.0e-5;
   double initial_velocity_std_mps = 0.05;

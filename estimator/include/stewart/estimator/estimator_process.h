@@ -90,6 +90,9 @@ class EstimatorProcess {
                std::optional<int64_t> receive_wall_us = std::nullopt);
 
   const Ekf& ekf() const { return ekf_; }
+  /// The EKF events (EkfEvent bits) of the last sample updated: what a
+  /// trajectory shows beside the estimate (which sensors were gated).
+  uint32_t last_update_events() const { return last_update_events_; }
   /// Ekf::ShareModelTerms.
   void ShareModelTerms(std::shared_ptr<SharedDynamicsTerms> shared) {
     ekf_.ShareModelTerms(std::move(shared));
@@ -122,6 +125,7 @@ class EstimatorProcess {
   std::optional<WaitingSample> waiting_;
   int64_t last_sample_utime_ = -1;    ///< the newest sample updated (or waiting)
   int64_t newest_answer_utime_ = -1;  ///< the newest sample_utime of a plausible command
+  uint32_t last_update_events_ = 0;
 };
 
 }  // namespace stewart

@@ -38,12 +38,14 @@ void DynamicsAccelerationJacobians(const PlatformParams& params, double friction
 /// inertial part -M^-1 dM/dq qdd, which d enters, is left out as there).
 /// `shared`: the model terms through it when not null (its parameters are
 /// `params`: AttachSharedTerms). `dqdd_dforce`, when not null: M^-1 H.
+/// `h`, when not null: H (leg forces to generalised forces, N -> N and
+/// N m per rad).
 void DynamicsAccelerationJacobians(const PlatformParams& params, double friction_nspm,
                                    const Vector6d& q, const EulerAngleTrig& trig,
                                    const Vector6d& qd, const Vector6d& force_n,
                                    const Vector6d& disturbance_n, Vector6d* qdd, Matrix6d* dqdd_dq,
                                    Matrix6d* dqdd_dqd, Matrix6d* m_inv,
                                    SharedDynamicsTerms* shared = nullptr,
-                                   Matrix6d* dqdd_dforce = nullptr);
+                                   Matrix6d* dqdd_dforce = nullptr, Matrix6d* h = nullptr);
 
 }  // namespace stewart
