@@ -347,14 +347,14 @@ void Ekf::Predict(double dt_s, int64_t utime, const EulerAngleTrig& trig, bool d
   legs_were_held_ = legs_held;
   double sigma_lin = config_.process_accel_std_mps2;
   double sigma_ang = config_.process_angaccel_std_radps2;
-  const bool gain_allowed =
+  const bool force_change_allowed =
       use_dynamics && config_.estimate_disturbance && config_.disturbance_force_change_std > 0.0;
   if (use_dynamics) {
     const bool latency_allowed = config_.command_latency_allowance_s > 0.0;
     DynamicsAccelerationJacobians(
         params_, leg_damping_nspm_, q, trig, qd, command->force_n, x_.segment<6>(kEkfDisturbance),
         &qdd_, &dqdd_dq_, &dqdd_dqd_, &m_inv_, shared_terms_.get(),
-        latency_allowed ? &dqdd_dforce_ : nullptr, gain_allowed ? &h_ : nullptr);
+        latency_allowed ? &dqdd_dforce_ : nullptr, force_change_allowed ? &h_ : nullptr);
     latency_accel_ =
         latency_allowed ? LatencyAccelerationError(*command, last_utime_, qd) : Vector6d::Zero();
     sigma_lin = config_.dynamics_accel_std_mps2;
@@ -443,11 +443,12 @@ void Ekf::Predict(double dt_s, int64_t utime, const EulerAngleTrig& trig, bool d
     P_.diagonal().segment<3>(kEkfDisturbance).array() += walk_n * walk_n * dt_s;
     P_.diagonal().segment<3>(kEkfDisturbance + 3).array() += walk_nm * walk_nm * dt_s;
   }
-  if (gain_allowed) {
-    // d holds (M - M_true) qdd + H diag(gain - 1) F + ...: a change of the
-    // command changes those parts at once, by about a fraction of H dF,
-    // which d's walk (sized for slow changes) cannot follow; the gyro and
-    // the accelerometer then disagreed until gated (docs/estimator.md,
+  if (force_change_allowed) {
+    // d holds (M - M_true) qdd + H diag(gain - 1) F - H diag(F_c) sign(ld)
+    // + ...: a change of the command changes those parts at once (the dry
+    // friction when it reverses legs), by about a share of H dF, which d's
+    // walk (sized for slow changes) cannot follow; the gyro and the
+    // accelerometer then disagreed until gated (docs/estimator.md,
     // "Force-change allowance").
     if (previous_model_force_n_) {
       const Vector6d spread =
