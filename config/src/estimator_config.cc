@@ -16,6 +16,9 @@ EstimatorConfig ParseEstimatorConfig(const ConfigNode& estimator) {
   e.dynamics_angaccel_std_radps2 = estimator.PositiveDouble("dynamics_angaccel_std_radps2");
   e.gyro_bias_walk_radps_per_sqrt_s =
       estimator.NonNegativeDouble("gyro_bias_walk_radps_per_sqrt_s");
+  if (estimator.Has("gyro_bias_walk_per_speed")) {
+    e.gyro_bias_walk_per_speed = estimator.NonNegativeDouble("gyro_bias_walk_per_speed");
+  }
   e.initial_velocity_std_mps = estimator.PositiveDouble("initial_velocity_std_mps");
   e.initial_angular_rate_std_radps = estimator.PositiveDouble("initial_angular_rate_std_radps");
   e.initial_gyro_bias_std_radps = estimator.PositiveDouble("initial_gyro_bias_std_radps");

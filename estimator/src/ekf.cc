@@ -171,6 +171,7 @@ Ekf::Ekf(const PlatformParams& params, const ActuatorConfig& actuators, const Se
       (sensors.leg_pot_noise_std_m * sensors.leg_pot_noise_std_m + step * step / 12.0);
   // A floor keeps S invertible for ideal (noise-free) sensor configs.
   leg_variance_m2_ = std::max(leg_variance_m2_, 1e-14);
+  platform_joint_radius_m_ = params.platform_joints_in_P_m.colwise().norm().maxCoeff();
   gyro_variance_ = std::max(sensors.gyro_noise_std_radps * sensors.gyro_noise_std_radps, 1e-14);
   accel_variance_ = std::max(sensors.accel_noise_std_mps2 * sensors.accel_noise_std_mps2, 1e-14);
   orientation_variance_ =
@@ -429,8 +430,13 @@ void Ekf::Predict(double dt_s, int64_t utime, const EulerAngleTrig& trig, bool d
     P_.block<6, 6>(kEkfQd, kEkfQ) += (0.5 * dt2 * dt_s) * e;
     P_.block<6, 6>(kEkfQd, kEkfQd) += dt2 * e;
   }
+  // The legs' pose under a joint error moves against the gyro's reading as
+  // fast as the platform moves (EstimatorConfig::gyro_bias_walk_per_speed).
+  const double speed_mps = qd.head<3>().norm() + platform_joint_radius_m_ * qd.tail<3>().norm();
   const double walk = config_.gyro_bias_walk_radps_per_sqrt_s;
-  P_.diagonal().segment<3>(kEkfGyroBias).array() += walk * walk * dt_s;
+  const double walk_moving = config_.gyro_bias_walk_per_speed * speed_mps;
+  P_.diagonal().segment<3>(kEkfGyroBias).array() +=
+      (walk * walk + walk_moving * walk_moving) * dt_s;
   if (EstimatesAccelBias()) {
     const double walk_a = config_.accel_bias_walk_mps2_per_sqrt_s;
     P_.diagonal().segment<2>(kEkfAccelBias).array() += walk_a * walk_a * dt_s;

@@ -152,6 +152,16 @@ TEST(Config, ForceChangeAllowance) {
                     "estimator.disturbance.force_change_std", "negative");
 }
 
+TEST(Config, GyroBiasWalkPerSpeed) {
+  const StackConfig c = LoadStackConfig(DefaultConfigPath());
+  EXPECT_DOUBLE_EQ(c.estimator.gyro_bias_walk_per_speed, 1e-3);
+  YAML::Node yaml = DefaultYaml();
+  yaml["estimator"].remove("gyro_bias_walk_per_speed");  // optional: none
+  EXPECT_EQ(ParseStackConfig(Emit(yaml)).estimator.gyro_bias_walk_per_speed, 0.0);
+  ExpectConfigError([](YAML::Node& y) { y["estimator"]["gyro_bias_walk_per_speed"] = -1e-3; },
+                    "estimator.gyro_bias_walk_per_speed", "negative");
+}
+
 TEST(Config, NotANumber) {
   ExpectConfigError([](YAML::Node& y) { y["platform"]["mass_kg"] = ".nan"; }, "platform.mass_kg",
                     "finite");

@@ -85,6 +85,7 @@ class Ekf {
   Vector6d home_pose_;
   Vector3d imu_offset_m_;
   double leg_variance_m2_;
+  double platform_joint_radius_m_;  // the largest; for the gyro bias's speed walk
   double gyro_variance_;
   double accel_variance_;
   double orientation_variance_;

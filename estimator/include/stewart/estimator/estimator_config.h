@@ -40,6 +40,14 @@ struct EstimatorConfig {
   double disturbance_force_change_std = 0.0;
   /// Random walk of the gyro bias (rad/s per sqrt(s)).
   double gyro_bias_walk_radps_per_sqrt_s = 1.0e-5;
+  /// More walk of the gyro bias while the platform moves, per m/s of
+  /// s = |v| + r_P |Euler rates| (r_P the platform joints' largest radius):
+  /// the walk is sqrt(walk^2 + (this * s)^2). Joints off the model's tilt
+  /// the pose the legs give by an error that changes as the platform moves,
+  /// while the gyro reads the true rates; to the EKF the difference is a
+  /// gyro bias that changes with the speed. (rad/s per sqrt(s)) per (m/s);
+  /// 0: off.
+  double gyro_bias_walk_per_speed = 0.0;
   double initial_velocity_std_mps = 0.05;
   double initial_angular_rate_std_radps = 0.2;
   double initial_gyro_bias_std_radps = 0.01;
