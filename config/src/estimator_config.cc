@@ -60,6 +60,9 @@ EstimatorConfig ParseEstimatorConfig(const ConfigNode& estimator) {
     if (d.Has("force_change_std")) {
       e.disturbance_force_change_std = d.NonNegativeDouble("force_change_std");
     }
+    if (d.Has("force_change_cap_n")) {
+      e.disturbance_force_change_cap_n = d.PositiveDouble("force_change_cap_n");
+    }
     if (e.estimate_disturbance && e.process_model != EstimatorProcessModel::kDynamics) {
       d.Fail("enabled", "needs estimator.process_model: dynamics (d acts through the dynamics)");
     }

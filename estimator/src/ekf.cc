@@ -457,8 +457,10 @@ void Ekf::Predict(double dt_s, int64_t utime, const EulerAngleTrig& trig, bool d
     // accelerometer then disagreed until gated (docs/estimator.md,
     // "Force-change allowance").
     if (previous_model_force_n_) {
+      const double cap_n = config_.disturbance_force_change_cap_n;
       const Vector6d spread =
-          config_.disturbance_force_change_std * (command->force_n - *previous_model_force_n_);
+          config_.disturbance_force_change_std *
+          (command->force_n - *previous_model_force_n_).cwiseMax(-cap_n).cwiseMin(cap_n);
       if (!spread.isZero()) {
         const Matrix6d h_spread = h_ * spread.asDiagonal();
         P_.block<6, 6>(kEkfDisturbance, kEkfDisturbance).noalias() +=

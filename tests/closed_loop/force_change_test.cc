@@ -7,9 +7,18 @@
 // allowance (estimator.disturbance.force_change_std) the gyro was gated two
 // samples of three for 150 ms, the velocity estimate lagged the truth by
 // 5 mm/s and xd went 2.9 mm/s past its limit.
+//
+// And where the allowance fed back: the bounds' random campaign run 409
+// (config/truths/bounds-force-change-loop.yaml and its setpoints). Against
+// the x limit with both of its conditions active, the filter's command
+// changed, the allowance widened d's std in proportion, the robust margin
+// grew with the std and the command changed more: 11 N in one tick, zd
+// 30 mm/s past its limit. Each leg's change counts at most
+// estimator.disturbance.force_change_cap_n.
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <limits>
 #include <string>
 
 #include "stewart/config/default_config.h"
@@ -23,20 +32,28 @@ namespace {
 
 constexpr double kLimitTolerance = 1e-3;  // m and m/s, docs/safety.md "Tolerance"
 
-ClosedLoopSummary RunReversal(const StackConfig& config) {
+/// The campaign run whose truth is config/truths/`name`.yaml, with its
+/// setpoints (`name`-scenario.yaml) and its seed.
+ClosedLoopSummary RunCampaignTruth(const StackConfig& config, const std::string& name,
+                                   uint64_t seed) {
   const std::string truths = std::string(STEWART_SOURCE_DIR) + "/config/truths/";
-  const Scenario scenario = LoadScenario(truths + "bounds-dry-friction-reversal-scenario.yaml");
+  const Scenario scenario = LoadScenario(truths + name + "-scenario.yaml");
   ClosedLoopOptions options;
-  options.seed = 4140594655u;  // the campaign run's
-  options.truth = LoadPlantTruth(config, truths + "bounds-dry-friction-reversal.yaml");
+  options.seed = seed;
+  options.truth = LoadPlantTruth(config, truths + name + ".yaml");
   const ClosedLoopSummary s = RunClosedLoop(config, scenario, options, nullptr);
   std::printf(
-      "[force change] allowance std %.2f: worst excess %.2f mm(/s) (%s), restarts %ld, "
-      "rms velocity error %.2f mm/s\n",
-      config.estimator.disturbance_force_change_std, s.max_limit_excess * 1e3,
+      "[force change] %s, allowance std %.2f cap %g N: worst excess %.2f mm(/s) (%s), "
+      "restarts %ld, rms velocity error %.2f mm/s\n",
+      name.c_str(), config.estimator.disturbance_force_change_std,
+      config.estimator.disturbance_force_change_cap_n, s.max_limit_excess * 1e3,
       s.max_limit_excess_name.c_str(), static_cast<long>(s.estimator_reinits),
       s.rms_qd_error * 1e3);
   return s;
+}
+
+ClosedLoopSummary RunReversal(const StackConfig& config) {
+  return RunCampaignTruth(config, "bounds-dry-friction-reversal", 4140594655u);
 }
 
 TEST(ForceChange, DryFrictionReversedByASetpointStepKeepsTheVelocityLimits) {
@@ -49,6 +66,22 @@ TEST(ForceChange, DryFrictionReversedByASetpointStepKeepsTheVelocityLimits) {
   ASSERT_TRUE(with.completed);
   EXPECT_LE(with.max_limit_excess, kLimitTolerance) << with.max_limit_excess_name;
   EXPECT_EQ(with.estimator_reinits, 0);
+}
+
+TEST(ForceChange, TheAllowanceDoesNotFeedTheFiltersMarginBack) {
+  StackConfig uncapped_config = DefaultStackConfig();
+  ASSERT_LT(uncapped_config.estimator.disturbance_force_change_cap_n, 10.0);
+  uncapped_config.estimator.disturbance_force_change_cap_n =
+      std::numeric_limits<double>::infinity();
+  const ClosedLoopSummary uncapped =
+      RunCampaignTruth(uncapped_config, "bounds-force-change-loop", 1429968929u);
+  ASSERT_TRUE(uncapped.completed);
+  EXPECT_GT(uncapped.max_limit_excess, 10 * kLimitTolerance) << uncapped.max_limit_excess_name;
+  const ClosedLoopSummary capped =
+      RunCampaignTruth(DefaultStackConfig(), "bounds-force-change-loop", 1429968929u);
+  ASSERT_TRUE(capped.completed);
+  EXPECT_LE(capped.max_limit_excess, kLimitTolerance) << capped.max_limit_excess_name;
+  EXPECT_EQ(capped.estimator_reinits, 0);
 }
 
 }  // namespace

@@ -150,6 +150,12 @@ TEST(Config, ForceChangeAllowance) {
   EXPECT_EQ(ParseStackConfig(Emit(yaml)).estimator.disturbance_force_change_std, 0.0);
   ExpectConfigError([](YAML::Node& y) { y["estimator"]["disturbance"]["force_change_std"] = -0.1; },
                     "estimator.disturbance.force_change_std", "negative");
+  EXPECT_DOUBLE_EQ(c.estimator.disturbance_force_change_cap_n, 2.0);
+  yaml["estimator"]["disturbance"].remove("force_change_cap_n");  // optional: no cap
+  EXPECT_TRUE(std::isinf(ParseStackConfig(Emit(yaml)).estimator.disturbance_force_change_cap_n));
+  ExpectConfigError(
+      [](YAML::Node& y) { y["estimator"]["disturbance"]["force_change_cap_n"] = 0.0; },
+      "estimator.disturbance.force_change_cap_n", "positive");
 }
 
 TEST(Config, GyroBiasWalkPerSpeed) {

@@ -18,6 +18,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 #include "stewart/config/default_config.h"
 #include "stewart/estimator/ekf.h"
@@ -108,6 +109,58 @@ TEST(EkfForceChange, LegsReversedByACommandStepThroughDryFrictionAreFollowedWith
   EXPECT_EQ(after.divergences, 0);
   EXPECT_LT(after.worst_rate_error_radps, 0.5 * before.worst_rate_error_radps);
   EXPECT_LT(after.worst_xd_error_mps, 0.5 * before.worst_xd_error_mps);
+}
+
+/// The trace of d's force rows' covariance (N^2) after the sample that
+/// follows a step of leg 0's command by `step_n`, on a still platform held
+/// at home by the model's force.
+double ForceRowsVarianceAfterAStep(double step_n, double cap_n) {
+  StackConfig c = DefaultStackConfig();
+  c.estimator.disturbance_force_change_cap_n = cap_n;
+  Ekf ekf(c.platform, c.actuators, c.sensors, c.estimator, c.home_pose);
+  const Vector6d q = c.home_pose, qd = Vector6d::Zero();
+  const Vector6d hold_n = InverseDynamics(EvaluateDynamics(c.platform, q, qd), Vector6d::Zero());
+  constexpr int kArm = 200, kStep = 600;
+  for (int k = 0; k <= kStep + 1; ++k) {
+    SensorSample s;
+    s.utime = 1'000'000 + 1000 * static_cast<int64_t>(k);
+    s.drive_off = k < kArm;
+    s.leg_length_m = InverseKinematics(c.platform, q);
+    s.accel_mps2 = ImuSpecificForce(q, qd, Vector6d::Zero(), c.sensors.imu_offset_in_P_m,
+                                    c.platform.gravity_mps2);
+    s.gyro_radps = BodyAngularVelocity(q, qd) + c.sensors.gyro_bias_radps;
+    ekf.Update(s);
+    Vector6d command_n = k < kArm ? Vector6d::Zero() : hold_n;
+    if (k == kStep) command_n(0) += step_n;
+    ekf.SetForceCommand(s.utime, command_n, k < kArm);
+  }
+  return ekf.P().block<3, 3>(kEkfDisturbance, kEkfDisturbance).trace();
+}
+
+// Each leg's change counts at most estimator.disturbance.force_change_cap_n:
+// a larger one widens d as much as the cap, a smaller one in proportion.
+TEST(EkfForceChange, EachLegsChangeCountsAtMostTheCap) {
+  constexpr double kCapN = 2.0;
+  constexpr double kNoCap = std::numeric_limits<double>::infinity();
+  const double steady = ForceRowsVarianceAfterAStep(0.0, kCapN);
+  const double small_capped = ForceRowsVarianceAfterAStep(1.0, kCapN);
+  const double small_uncapped = ForceRowsVarianceAfterAStep(1.0, kNoCap);
+  const double at_cap = ForceRowsVarianceAfterAStep(kCapN, kCapN);
+  const double large_capped = ForceRowsVarianceAfterAStep(10.0, kCapN);
+  const double large_uncapped = ForceRowsVarianceAfterAStep(10.0, kNoCap);
+  std::printf(
+      "[force change] d's force-row variance after a step (N^2): none %.3g, 1 N %.3g, 2 N %.3g, "
+      "10 N %.3g capped at 2 N, %.3g uncapped\n",
+      steady, small_capped, at_cap, large_capped, large_uncapped);
+  EXPECT_GT(small_capped, steady);
+  EXPECT_NEAR(small_capped, small_uncapped, 1e-9 * small_uncapped);
+  // The 10 N step's prediction differs from the 2 N step's, so the sample's
+  // corrections take a little more or less of the variance; within a tenth
+  // of what the step added.
+  EXPECT_NEAR(large_capped, at_cap, 0.1 * (at_cap - steady));
+  // Uncapped, the allowance grows with the square of the step: 25 times the
+  // cap's at 10 N.
+  EXPECT_GT(large_uncapped - steady, 10.0 * (at_cap - steady));
 }
 
 }  // namespace

@@ -1,5 +1,7 @@
 #pragma once
 
+#include <limits>
+
 namespace stewart {
 
 /// Process model of the EKF (docs/estimator.md explains the choice).
@@ -38,6 +40,14 @@ struct EstimatorConfig {
   /// predict adds H diag((std dF_i)^2) H^T to d's covariance, dF the change
   /// of the command acting since the previous interval (N). 0: off.
   double disturbance_force_change_std = 0.0;
+  /// Largest change of one leg's command (N) the allowance above answers in
+  /// full; a larger change counts as this much. The filter's robust margin
+  /// grows with d's std, and where the closed form answers a margin with a
+  /// large force (both conditions of an axis active, near-parallel normals)
+  /// an allowance in proportion to the whole change fed its own command
+  /// changes back through the margin (docs/estimator.md, "Force-change
+  /// allowance"). Infinite: no cap.
+  double disturbance_force_change_cap_n = std::numeric_limits<double>::infinity();
   /// Random walk of the gyro bias (rad/s per sqrt(s)).
   double gyro_bias_walk_radps_per_sqrt_s = 1.0e-5;
   /// More walk of the gyro bias while the platform moves, per m/s of
