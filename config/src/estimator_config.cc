@@ -25,6 +25,9 @@ EstimatorConfig ParseEstimatorConfig(const ConfigNode& estimator) {
   e.initial_accel_bias_std_mps2 = estimator.NonNegativeDouble("initial_accel_bias_std_mps2");
   e.accel_bias_walk_mps2_per_sqrt_s =
       estimator.NonNegativeDouble("accel_bias_walk_mps2_per_sqrt_s");
+  if (estimator.Has("accel_bias_walk_per_speed")) {
+    e.accel_bias_walk_per_speed = estimator.NonNegativeDouble("accel_bias_walk_per_speed");
+  }
   if (estimator.Has("accel_bias_axes")) {
     e.estimate_accel_bias_z = estimator.Choice("accel_bias_axes", {"xyz", "xy"}) == "xyz";
   }

@@ -431,7 +431,9 @@ void Ekf::Predict(double dt_s, int64_t utime, const EulerAngleTrig& trig, bool d
     P_.block<6, 6>(kEkfQd, kEkfQd) += dt2 * e;
   }
   // The legs' pose under a joint error moves against the gyro's reading as
-  // fast as the platform moves (EstimatorConfig::gyro_bias_walk_per_speed).
+  // fast as the platform moves, and its tilt against the accelerometer's
+  // gravity (EstimatorConfig::gyro_bias_walk_per_speed,
+  // accel_bias_walk_per_speed).
   const double speed_mps = qd.head<3>().norm() + platform_joint_radius_m_ * qd.tail<3>().norm();
   const double walk = config_.gyro_bias_walk_radps_per_sqrt_s;
   const double walk_moving = config_.gyro_bias_walk_per_speed * speed_mps;
@@ -439,9 +441,10 @@ void Ekf::Predict(double dt_s, int64_t utime, const EulerAngleTrig& trig, bool d
       (walk * walk + walk_moving * walk_moving) * dt_s;
   if (EstimatesAccelBias()) {
     const double walk_a = config_.accel_bias_walk_mps2_per_sqrt_s;
-    P_.diagonal().segment<2>(kEkfAccelBias).array() += walk_a * walk_a * dt_s;
-    if (config_.estimate_accel_bias_z)
-      P_(kEkfAccelBias + 2, kEkfAccelBias + 2) += walk_a * walk_a * dt_s;
+    const double walk_a_moving = config_.accel_bias_walk_per_speed * speed_mps;
+    const double variance_a = (walk_a * walk_a + walk_a_moving * walk_a_moving) * dt_s;
+    P_.diagonal().segment<2>(kEkfAccelBias).array() += variance_a;
+    if (config_.estimate_accel_bias_z) P_(kEkfAccelBias + 2, kEkfAccelBias + 2) += variance_a;
   }
   if (config_.estimate_disturbance) {
     const double walk_n = config_.disturbance_walk_n_per_sqrt_s;

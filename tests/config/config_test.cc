@@ -168,6 +168,16 @@ TEST(Config, GyroBiasWalkPerSpeed) {
                     "estimator.gyro_bias_walk_per_speed", "negative");
 }
 
+TEST(Config, AccelBiasWalkPerSpeed) {
+  const StackConfig c = LoadStackConfig(DefaultConfigPath());
+  EXPECT_DOUBLE_EQ(c.estimator.accel_bias_walk_per_speed, 0.3);
+  YAML::Node yaml = DefaultYaml();
+  yaml["estimator"].remove("accel_bias_walk_per_speed");  // optional: none
+  EXPECT_EQ(ParseStackConfig(Emit(yaml)).estimator.accel_bias_walk_per_speed, 0.0);
+  ExpectConfigError([](YAML::Node& y) { y["estimator"]["accel_bias_walk_per_speed"] = -0.1; },
+                    "estimator.accel_bias_walk_per_speed", "negative");
+}
+
 TEST(Config, NotANumber) {
   ExpectConfigError([](YAML::Node& y) { y["platform"]["mass_kg"] = ".nan"; }, "platform.mass_kg",
                     "finite");

@@ -66,6 +66,13 @@ struct EstimatorConfig {
   /// sqrt(s)).
   double initial_accel_bias_std_mps2 = 0.0;
   double accel_bias_walk_mps2_per_sqrt_s = 0.0;
+  /// More walk of the accelerometer's bias while the platform moves, per
+  /// m/s of the same speed s as gyro_bias_walk_per_speed: the walk is
+  /// sqrt(walk^2 + (this * s)^2). The tilt a wrong geometry puts into the
+  /// pose changes as the platform moves, and with it the share of gravity
+  /// the accelerometer reads against the estimate's attitude.
+  /// (m/s^2 per sqrt(s)) per (m/s); 0: off.
+  double accel_bias_walk_per_speed = 0.0;
   /// Optional key `accel_bias_axes: xyz | xy` (default xyz): with xy the
   /// bias along {P}'s z is held at zero. The tilt a wrong geometry puts
   /// into the pose shows in x and y; along z a bias shares out a vertical
