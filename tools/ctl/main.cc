@@ -15,12 +15,11 @@
 #include <chrono>
 #include <iostream>
 #include <random>
-#include <thread>
 
-#include "stewart/node/lcm_receiver.h"
 #include "stewart/node/message_auth.h"
 #include "stewart/node/node_main.h"
 #include "stewart/node/stop_signal.h"
+#include "stewart/node/supervisor_listener.h"
 #include "stewart/operator_command_t.hpp"
 #include "stewart/safety/supervisor.h"
 #include "stewart/supervisor_state_t.hpp"
@@ -38,47 +37,6 @@ const char* StateName(int8_t state) {
   if (state < 0 || state > static_cast<int8_t>(safety::SupervisorState::kEstop)) return "UNKNOWN";
   return safety::ToString(static_cast<safety::SupervisorState>(state));
 }
-
-/// Listens to the supervisor's channel; keeps the newest verified state.
-class SupervisorListener {
- public:
-  SupervisorListener(const StackConfig& config, MessageAuthenticator* auth)
-      : receiver_(config.lcm.url), auth_(auth) {
-    receiver_.Subscribe(config.lcm.channels.supervisor, &SupervisorListener::On, this);
-  }
-  /// Waits until `accept` holds for a received state or the timeout passes.
-  template <class Pred>
-  bool WaitFor(double timeout_s, Pred accept) {
-    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
-    while (!StopRequested()) {
-      if (has_ && accept(latest_)) return true;
-      const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
-                            end - std::chrono::steady_clock::now())
-                            .count();
-      if (left <= 0) return false;
-      has_ = false;
-      receiver_.HandleTimeout(static_cast<int>(std::min<int64_t>(left, 50)));
-    }
-    return false;
-  }
-  const supervisor_state_t& latest() const { return latest_; }
-  int64_t forged() const { return forged_; }
-
- private:
-  void On(const lcm::ReceiveBuffer*, const std::string&, const supervisor_state_t* msg) {
-    if (!auth_->Verify(*msg)) {
-      ++forged_;
-      return;
-    }
-    latest_ = *msg;
-    has_ = true;
-  }
-  LcmReceiver receiver_;
-  MessageAuthenticator* auth_;
-  supervisor_state_t latest_{};
-  bool has_ = false;
-  int64_t forged_ = 0;
-};
 
 void PrintState(const supervisor_state_t& s) {
   std::cout << StateName(s.state) << std::endl;
@@ -114,17 +72,18 @@ int main(int argc, char** argv) {
       [&](const stewart::StackConfig& config, lcm::LCM* lcm) -> stewart::ExitCode {
         stewart::MessageAuthenticator auth =
             stewart::MessageAuthenticator::FromKeyFile(config.lcm.auth_key_file);
-        stewart::SupervisorListener listener(config, &auth);
         const std::string& channel = config.lcm.channels.supervisor;
+        stewart::SupervisorListener listener(config.lcm.url, channel, &auth);
         if (verb == "status") {
-          if (!listener.WaitFor(timeout_s, [](const auto&) { return true; })) {
+          if (!listener.WaitFor(
+                  timeout_s, [](const auto&) { return true; }, stewart::StopRequested)) {
             spdlog::error(
                 "no supervisor state on {} within {} s (is the safety process running on {}?){}",
                 channel, timeout_s, config.lcm.url,
                 listener.forged() > 0 ? " (states with a bad MAC were dropped)" : "");
             return stewart::ExitCode::kFault;
           }
-          stewart::PrintState(listener.latest());
+          stewart::PrintState(listener.matched());
           return stewart::ExitCode::kOk;
         }
         std::random_device device;
@@ -144,7 +103,8 @@ int main(int argc, char** argv) {
                        config.lcm.channels.operator_command, period_s);
           while (!stewart::StopRequested()) {
             send();
-            listener.WaitFor(period_s, [](const auto&) { return false; });
+            listener.WaitFor(
+                period_s, [](const auto&) { return false; }, stewart::StopRequested);
           }
           return stewart::ExitCode::kOk;
         }
@@ -152,14 +112,14 @@ int main(int argc, char** argv) {
         const auto is_reply = [&](const stewart::supervisor_state_t& s) {
           return s.last_operator_id == cmd.operator_id && s.last_operator_seq == cmd.seq;
         };
-        if (!listener.WaitFor(timeout_s, is_reply)) {
+        if (!listener.WaitFor(timeout_s, is_reply, stewart::StopRequested)) {
           spdlog::error(
               "no answer to '{}' on {} within {} s (is the safety process running on {}?){}", verb,
               channel, timeout_s, config.lcm.url,
               config.lcm.auth_key_file.empty() ? "" : " (a supervisor with another key drops it)");
           return stewart::ExitCode::kFault;
         }
-        const stewart::supervisor_state_t& reply = listener.latest();
+        const stewart::supervisor_state_t& reply = listener.matched();
         if (!reply.last_operator_reply.empty()) {
           std::cerr << "refused: " << reply.last_operator_reply << "\n";
           stewart::PrintState(reply);
