@@ -21,35 +21,20 @@
 #include <limits>
 #include <string>
 
+#include "campaign_truth.h"
 #include "stewart/config/default_config.h"
-#include "stewart/config/scenario_loader.h"
-#include "stewart/config/truth_loader.h"
-#include "stewart/controller/scenario.h"
-#include "stewart/stack/closed_loop.h"
 
 namespace stewart {
 namespace {
 
 constexpr double kLimitTolerance = 1e-3;  // m and m/s, docs/safety.md "Tolerance"
 
-/// The campaign run whose truth is config/truths/`name`.yaml, with its
-/// setpoints (`name`-scenario.yaml) and its seed.
 ClosedLoopSummary RunCampaignTruth(const StackConfig& config, const std::string& name,
                                    uint64_t seed) {
-  const std::string truths = std::string(STEWART_SOURCE_DIR) + "/config/truths/";
-  const Scenario scenario = LoadScenario(truths + name + "-scenario.yaml");
-  ClosedLoopOptions options;
-  options.seed = seed;
-  options.truth = LoadPlantTruth(config, truths + name + ".yaml");
-  const ClosedLoopSummary s = RunClosedLoop(config, scenario, options, nullptr);
-  std::printf(
-      "[force change] %s, allowance std %.2f cap %g N: worst excess %.2f mm(/s) (%s), "
-      "restarts %ld, rms velocity error %.2f mm/s\n",
-      name.c_str(), config.estimator.disturbance_force_change_std,
-      config.estimator.disturbance_force_change_cap_n, s.max_limit_excess * 1e3,
-      s.max_limit_excess_name.c_str(), static_cast<long>(s.estimator_reinits),
-      s.rms_qd_error * 1e3);
-  return s;
+  std::printf("[force change] allowance std %.2f, cap %g N:\n",
+              config.estimator.disturbance_force_change_std,
+              config.estimator.disturbance_force_change_cap_n);
+  return test::RunCampaignTruth(config, name, seed);
 }
 
 ClosedLoopSummary RunReversal(const StackConfig& config) {

@@ -1,0 +1,32 @@
+#pragma once
+// One campaign run replayed in process from what `stewart_campaign --rerun
+// DIR --row R --emit-truth` wrote into config/truths/: the truth
+// (`name`.yaml), its setpoints (`name`-scenario.yaml) and the run's seed.
+#include <cstdint>
+#include <cstdio>
+#include <string>
+
+#include "stewart/config/scenario_loader.h"
+#include "stewart/config/truth_loader.h"
+#include "stewart/controller/scenario.h"
+#include "stewart/stack/closed_loop.h"
+
+namespace stewart {
+namespace test {
+
+inline ClosedLoopSummary RunCampaignTruth(const StackConfig& config, const std::string& name,
+                                          uint64_t seed) {
+  const std::string truths = std::string(STEWART_SOURCE_DIR) + "/config/truths/";
+  const Scenario scenario = LoadScenario(truths + name + "-scenario.yaml");
+  ClosedLoopOptions options;
+  options.seed = seed;
+  options.truth = LoadPlantTruth(config, truths + name + ".yaml");
+  const ClosedLoopSummary s = RunClosedLoop(config, scenario, options, nullptr);
+  std::printf("[%s] worst excess %.2f mm(/s) (%s), restarts %ld, rms velocity error %.2f mm/s\n",
+              name.c_str(), s.max_limit_excess * 1e3, s.max_limit_excess_name.c_str(),
+              static_cast<long>(s.estimator_reinits), s.rms_qd_error * 1e3);
+  return s;
+}
+
+}  // namespace test
+}  // namespace stewart
