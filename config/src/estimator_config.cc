@@ -66,6 +66,12 @@ EstimatorConfig ParseEstimatorConfig(const ConfigNode& estimator) {
     if (d.Has("force_change_cap_n")) {
       e.disturbance_force_change_cap_n = d.PositiveDouble("force_change_cap_n");
     }
+    if (d.Has("friction_flip_std_n")) {
+      e.disturbance_friction_flip_std_n = d.NonNegativeDouble("friction_flip_std_n");
+    }
+    if (d.Has("friction_flip_speed_mps")) {
+      e.disturbance_friction_flip_speed_mps = d.NonNegativeDouble("friction_flip_speed_mps");
+    }
     if (e.estimate_disturbance && e.process_model != EstimatorProcessModel::kDynamics) {
       d.Fail("enabled", "needs estimator.process_model: dynamics (d acts through the dynamics)");
     }

@@ -216,7 +216,8 @@ void Ekf::Reset() {
   pose_reopened_utime_.reset();
   samples_since_accel_disagreed_ = kNeverDisagreed;
   samples_since_init_ = 0;
-  drive_on_window_ = false;  // a restart keeps its own d
+  drive_on_window_ = false;         // a restart keeps its own d
+  previous_leg_direction_.reset();  // a restart's velocity is a new estimate
 }
 
 void Ekf::Initialize(int64_t utime, const Vector6d& q, const Vector6d& qd, const EkfVector& std) {
@@ -240,7 +241,8 @@ void Ekf::Initialize(int64_t utime, const Vector6d& q, const Vector6d& qd, const
   pose_reopened_utime_.reset();
   samples_since_accel_disagreed_ = kNeverDisagreed;
   samples_since_init_ = 0;
-  drive_on_window_ = false;  // a restart keeps its own d
+  drive_on_window_ = false;         // a restart keeps its own d
+  previous_leg_direction_.reset();  // a restart's velocity is a new estimate
 }
 
 bool Ekf::LegsUsable(const SensorSample& sample, uint32_t* events) const {
@@ -350,12 +352,15 @@ void Ekf::Predict(double dt_s, int64_t utime, const EulerAngleTrig& trig, bool d
   double sigma_ang = config_.process_angaccel_std_radps2;
   const bool force_change_allowed =
       use_dynamics && config_.estimate_disturbance && config_.disturbance_force_change_std > 0.0;
+  const bool friction_flip_allowed =
+      use_dynamics && config_.estimate_disturbance && config_.disturbance_friction_flip_std_n > 0.0;
   if (use_dynamics) {
     const bool latency_allowed = config_.command_latency_allowance_s > 0.0;
-    DynamicsAccelerationJacobians(
-        params_, leg_damping_nspm_, q, trig, qd, command->force_n, x_.segment<6>(kEkfDisturbance),
-        &qdd_, &dqdd_dq_, &dqdd_dqd_, &m_inv_, shared_terms_.get(),
-        latency_allowed ? &dqdd_dforce_ : nullptr, force_change_allowed ? &h_ : nullptr);
+    DynamicsAccelerationJacobians(params_, leg_damping_nspm_, q, trig, qd, command->force_n,
+                                  x_.segment<6>(kEkfDisturbance), &qdd_, &dqdd_dq_, &dqdd_dqd_,
+                                  &m_inv_, shared_terms_.get(),
+                                  latency_allowed ? &dqdd_dforce_ : nullptr,
+                                  force_change_allowed || friction_flip_allowed ? &h_ : nullptr);
     latency_accel_ =
         latency_allowed ? LatencyAccelerationError(*command, last_utime_, qd) : Vector6d::Zero();
     sigma_lin = config_.dynamics_accel_std_mps2;
@@ -473,6 +478,41 @@ void Ekf::Predict(double dt_s, int64_t utime, const EulerAngleTrig& trig, bool d
     previous_model_force_n_ = command->force_n;
   } else {
     previous_model_force_n_.reset();
+  }
+  if (friction_flip_allowed) {
+    // A leg's dry friction -F_c sign(ld) flips by up to 2 F_c when the leg
+    // reverses, whether or not the command changed (a leg creeping through
+    // zero speed under a steady command): d's share of it jumps at once,
+    // while d's walk is sized for slow changes. The estimate's leg speeds
+    // ld = H^T qd at the interval's start tell when; a leg counts as
+    // reversed when its speed, last beyond friction_flip_speed_mps one way,
+    // is beyond it the other way, so that a leg dithering about zero (the
+    // estimate's noise, a filter switching cases) does not open d on every
+    // tick (docs/estimator.md, "Friction-flip allowance").
+    const Vector6d leg_speed_mps = h_.transpose() * qd;
+    const double band_mps = config_.disturbance_friction_flip_speed_mps;
+    const Vector6d direction =
+        (leg_speed_mps.array() > band_mps)
+            .select(
+                Vector6d::Ones(),
+                (leg_speed_mps.array() < -band_mps).select(-Vector6d::Ones(), Vector6d::Zero()));
+    if (previous_leg_direction_) {
+      const double flip_std_n = config_.disturbance_friction_flip_std_n;
+      const Vector6d spread = (direction.array() * previous_leg_direction_->array() < 0.0)
+                                  .select(Vector6d::Constant(flip_std_n), Vector6d::Zero());
+      if (!spread.isZero()) {
+        const Matrix6d h_spread = h_ * spread.asDiagonal();
+        P_.block<6, 6>(kEkfDisturbance, kEkfDisturbance).noalias() +=
+            h_spread * h_spread.transpose();
+      }
+      // A leg within the band keeps the direction it last had.
+      const Vector6d kept = (direction.array() != 0.0).select(direction, *previous_leg_direction_);
+      previous_leg_direction_ = kept;
+    } else {
+      previous_leg_direction_ = direction;
+    }
+  } else {
+    previous_leg_direction_.reset();
   }
 }
 

@@ -2,6 +2,8 @@
 // One campaign run replayed in process from what `stewart_campaign --rerun
 // DIR --row R --emit-truth` wrote into config/truths/: the truth
 // (`name`.yaml), its setpoints (`name`-scenario.yaml) and the run's seed.
+#include <gtest/gtest.h>
+
 #include <cstdint>
 #include <cstdio>
 #include <string>
@@ -26,6 +28,27 @@ inline ClosedLoopSummary RunCampaignTruth(const StackConfig& config, const std::
               name.c_str(), s.max_limit_excess * 1e3, s.max_limit_excess_name.c_str(),
               static_cast<long>(s.estimator_reinits), s.rms_qd_error * 1e3);
   return s;
+}
+
+constexpr double kLimitTolerance = 1e-3;  // m and m/s, docs/safety.md "Tolerance"
+
+struct WithoutAndWith {
+  ClosedLoopSummary without;
+  ClosedLoopSummary with;
+};
+
+/// Runs `run` with `without` and with `with`: the first must break a limit
+/// beyond the tolerance, the second hold every limit within it, without a
+/// restart of the estimate. Both summaries for further checks.
+template <class Run>
+WithoutAndWith ExpectHoldsOnlyWith(const StackConfig& without, const StackConfig& with, Run run) {
+  WithoutAndWith r{run(without), run(with)};
+  EXPECT_TRUE(r.without.completed);
+  EXPECT_GT(r.without.max_limit_excess, kLimitTolerance);
+  EXPECT_TRUE(r.with.completed);
+  EXPECT_LE(r.with.max_limit_excess, kLimitTolerance) << r.with.max_limit_excess_name;
+  EXPECT_EQ(r.with.estimator_reinits, 0);
+  return r;
 }
 
 }  // namespace test

@@ -27,11 +27,16 @@
 namespace stewart {
 namespace {
 
-constexpr double kLimitTolerance = 1e-3;  // m and m/s, docs/safety.md "Tolerance"
+using test::kLimitTolerance;
 
-ClosedLoopSummary RunCampaignTruth(const StackConfig& config, const std::string& name,
-                                   uint64_t seed) {
-  std::printf("[force change] allowance std %.2f, cap %g N:\n",
+/// The run with the friction-flip allowance off: these runs show what the
+/// force-change allowance and its cap do on their own. (With the flip
+/// allowance on, both runs hold even without the force-change allowance or
+/// its cap: -2.2 and -1.2 mm/s; docs/estimator.md, "Friction-flip
+/// allowance".)
+ClosedLoopSummary RunCampaignTruth(StackConfig config, const std::string& name, uint64_t seed) {
+  config.estimator.disturbance_friction_flip_std_n = 0.0;
+  std::printf("[force change] allowance std %.2f, cap %g N, friction-flip allowance off:\n",
               config.estimator.disturbance_force_change_std,
               config.estimator.disturbance_force_change_cap_n);
   return test::RunCampaignTruth(config, name, seed);
@@ -44,13 +49,7 @@ ClosedLoopSummary RunReversal(const StackConfig& config) {
 TEST(ForceChange, DryFrictionReversedByASetpointStepKeepsTheVelocityLimits) {
   StackConfig without_config = DefaultStackConfig();
   without_config.estimator.disturbance_force_change_std = 0.0;
-  const ClosedLoopSummary without = RunReversal(without_config);
-  ASSERT_TRUE(without.completed);
-  EXPECT_GT(without.max_limit_excess, kLimitTolerance);
-  const ClosedLoopSummary with = RunReversal(DefaultStackConfig());
-  ASSERT_TRUE(with.completed);
-  EXPECT_LE(with.max_limit_excess, kLimitTolerance) << with.max_limit_excess_name;
-  EXPECT_EQ(with.estimator_reinits, 0);
+  test::ExpectHoldsOnlyWith(without_config, DefaultStackConfig(), RunReversal);
 }
 
 TEST(ForceChange, TheAllowanceDoesNotFeedTheFiltersMarginBack) {

@@ -158,6 +158,17 @@ TEST(Config, ForceChangeAllowance) {
       "estimator.disturbance.force_change_cap_n", "positive");
 }
 
+TEST(Config, FrictionFlipAllowance) {
+  const StackConfig c = LoadStackConfig(DefaultConfigPath());
+  EXPECT_DOUBLE_EQ(c.estimator.disturbance_friction_flip_std_n, 0.1);
+  YAML::Node yaml = DefaultYaml();
+  yaml["estimator"]["disturbance"].remove("friction_flip_std_n");  // optional: none
+  EXPECT_EQ(ParseStackConfig(Emit(yaml)).estimator.disturbance_friction_flip_std_n, 0.0);
+  ExpectConfigError(
+      [](YAML::Node& y) { y["estimator"]["disturbance"]["friction_flip_std_n"] = -0.1; },
+      "estimator.disturbance.friction_flip_std_n", "negative");
+}
+
 TEST(Config, GyroBiasWalkPerSpeed) {
   const StackConfig c = LoadStackConfig(DefaultConfigPath());
   EXPECT_DOUBLE_EQ(c.estimator.gyro_bias_walk_per_speed, 1e-3);

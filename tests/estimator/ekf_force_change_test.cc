@@ -20,6 +20,7 @@
 #include <cstdio>
 #include <limits>
 
+#include "ekf_harness.h"
 #include "stewart/config/default_config.h"
 #include "stewart/estimator/ekf.h"
 #include "stewart/model/dynamics.h"
@@ -40,6 +41,7 @@ struct ReversalRun {
 ReversalRun RunReversal(double force_change_std) {
   StackConfig c = DefaultStackConfig();
   c.estimator.disturbance_force_change_std = force_change_std;
+  c.estimator.disturbance_friction_flip_std_n = 0.0;  // this allowance alone
   Ekf ekf(c.platform, c.actuators, c.sensors, c.estimator, c.home_pose);
   constexpr double kDryFrictionN = 0.3;
   constexpr double kDt = 1e-3;
@@ -53,13 +55,7 @@ ReversalRun RunReversal(double force_change_std) {
   for (int k = 0; k < kEnd; ++k) {
     if (k == kArm) qd(1) = -1e-3;  // the drive on: the platform creeps
     const Vector6d qdd = k >= kStep ? qdd_step : Vector6d::Zero();
-    SensorSample s;
-    s.utime = 1'000'000 + 1000 * static_cast<int64_t>(k);
-    s.drive_off = k < kArm;
-    s.leg_length_m = InverseKinematics(c.platform, q);
-    s.accel_mps2 =
-        ImuSpecificForce(q, qd, qdd, c.sensors.imu_offset_in_P_m, c.platform.gravity_mps2);
-    s.gyro_radps = BodyAngularVelocity(q, qd) + c.sensors.gyro_bias_radps;
+    const SensorSample s = test::NoiselessSample(c, k, k < kArm, q, qd, qdd);
     const UpdateResult r = ekf.Update(s);
     if (r.Has(kEventDiverged)) ++run.divergences;
     if (k >= kStep) {
@@ -122,13 +118,7 @@ double ForceRowsVarianceAfterAStep(double step_n, double cap_n) {
   const Vector6d hold_n = InverseDynamics(EvaluateDynamics(c.platform, q, qd), Vector6d::Zero());
   constexpr int kArm = 200, kStep = 600;
   for (int k = 0; k <= kStep + 1; ++k) {
-    SensorSample s;
-    s.utime = 1'000'000 + 1000 * static_cast<int64_t>(k);
-    s.drive_off = k < kArm;
-    s.leg_length_m = InverseKinematics(c.platform, q);
-    s.accel_mps2 = ImuSpecificForce(q, qd, Vector6d::Zero(), c.sensors.imu_offset_in_P_m,
-                                    c.platform.gravity_mps2);
-    s.gyro_radps = BodyAngularVelocity(q, qd) + c.sensors.gyro_bias_radps;
+    const SensorSample s = test::NoiselessSample(c, k, k < kArm, q, qd, Vector6d::Zero());
     ekf.Update(s);
     Vector6d command_n = k < kArm ? Vector6d::Zero() : hold_n;
     if (k == kStep) command_n(0) += step_n;

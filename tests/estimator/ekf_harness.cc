@@ -1,6 +1,8 @@
 #include "ekf_harness.h"
 
 #include "stewart/config/default_config.h"
+#include "stewart/model/imu.h"
+#include "stewart/model/kinematics.h"
 
 namespace stewart::test {
 
@@ -58,6 +60,17 @@ RunStats RunScenario(const StackConfig& config, unsigned seed, double t_end_s, d
     previous = now;
   }
   return stats;
+}
+
+SensorSample NoiselessSample(const StackConfig& c, int k, bool drive_off, const Vector6d& q,
+                             const Vector6d& qd, const Vector6d& qdd) {
+  SensorSample s;
+  s.utime = 1'000'000 + 1000 * static_cast<int64_t>(k);
+  s.drive_off = drive_off;
+  s.leg_length_m = InverseKinematics(c.platform, q);
+  s.accel_mps2 = ImuSpecificForce(q, qd, qdd, c.sensors.imu_offset_in_P_m, c.platform.gravity_mps2);
+  s.gyro_radps = BodyAngularVelocity(q, qd) + c.sensors.gyro_bias_radps;
+  return s;
 }
 
 }  // namespace stewart::test

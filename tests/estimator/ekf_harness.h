@@ -37,4 +37,10 @@ const StackConfig& EstimatorTestConfig();
 /// The EKF the estimator process builds from `c`, started at its home pose.
 Ekf MakeEkf(const StackConfig& c);
 
+/// The noiseless reading of the state (q, qd, qdd) at 1 kHz sample `k`
+/// (utime 1 s + k ms): leg lengths, the IMU's specific force and the body
+/// rates with the config's gyro bias.
+SensorSample NoiselessSample(const StackConfig& c, int k, bool drive_off, const Vector6d& q,
+                             const Vector6d& qd, const Vector6d& qdd);
+
 }  // namespace stewart::test

@@ -155,6 +155,11 @@ class Ekf {
   /// the legs were held or no command acted).
   Matrix6d h_ = Matrix6d::Zero();
   std::optional<Vector6d> previous_model_force_n_;
+  /// See Predict (disturbance_friction_flip_std_n): each leg's direction
+  /// (+1 lengthening, -1 shortening, 0 not yet known) when its estimated
+  /// speed ld = H^T qd was last beyond disturbance_friction_flip_speed_mps
+  /// (absent when the model did not act or after a restart).
+  std::optional<Vector6d> previous_leg_direction_;
   /// The largest such error among the commands that may act instead of the
   /// model's `command` over the interval starting at `interval_start_utime`.
   Vector6d LatencyAccelerationError(const TimedCommand& command, int64_t interval_start_utime,

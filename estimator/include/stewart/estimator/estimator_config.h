@@ -48,6 +48,18 @@ struct EstimatorConfig {
   /// changes back through the margin (docs/estimator.md, "Force-change
   /// allowance"). Infinite: no cap.
   double disturbance_force_change_cap_n = std::numeric_limits<double>::infinity();
+  /// Std (N) of the change of a leg's dry friction when the leg reverses:
+  /// at each predict where the estimate's speed of leg i, ld_i = (H^T qd)_i,
+  /// changed sign since the previous predict, d's covariance takes
+  /// + std^2 h_i h_i^T (h_i: H's column i). The friction's flip is up to
+  /// 2 F_c and comes with no change of the command when a leg creeps
+  /// through zero speed. 0: off.
+  double disturbance_friction_flip_std_n = 0.0;
+  /// A leg counts as reversed for the allowance above when its estimated
+  /// speed, last beyond this (m/s) one way, is beyond it the other way:
+  /// within the band the friction turns over gradually (and the estimate's
+  /// noise would flip the sign on every tick at rest).
+  double disturbance_friction_flip_speed_mps = 0.0;
   /// Random walk of the gyro bias (rad/s per sqrt(s)).
   double gyro_bias_walk_radps_per_sqrt_s = 1.0e-5;
   /// More walk of the gyro bias while the platform moves, per m/s of
