@@ -253,13 +253,6 @@ TEST_F(HostsLab, DelayLossAndAPartitionBetweenControlAndDevice) {
   // commands past the plant's command timeout, and its forwarding of every
   // message took the CPU the four loop processes share.
   const std::string kRelayCpu = "0";
-  const auto relay = [&](const std::string& delay_ms, const std::string& jitter_ms,
-                         const std::string& loss) {
-    return on("observer", kRelayCpu,
-              {NETRELAY_PATH, "--a", device_url, "--b", control_url, "--delay-ms", delay_ms,
-               "--jitter-ms", jitter_ms, "--loss", loss});
-  };
-
   std::unique_ptr<lcm::LCM> lcm = MakeLcm(device_url);
   DeviceSide bus;
   const auto& ch = config.lcm.channels;
@@ -275,6 +268,24 @@ TEST_F(HostsLab, DelayLossAndAPartitionBetweenControlAndDevice) {
     return true;
   };
   const auto pump = [&](double seconds) { pump_until([] { return false; }, seconds); };
+  // A new link is up once the relay has joined both groups: only then is the
+  // old one stopped, so changing the link is not a partition of its own (a
+  // relay started through ip netns exec, taskset and chrt on a busy machine
+  // took longer than the plant's 50 ms command timeout).
+  int relays_started = 0;
+  const auto relay = [&](const std::string& delay_ms, const std::string& jitter_ms,
+                         const std::string& loss) {
+    const std::string ready = run_folder_ + "/relay" + std::to_string(++relays_started) + ".ready";
+    auto process = on("observer", kRelayCpu,
+                      {NETRELAY_PATH, "--a", device_url, "--b", control_url, "--delay-ms", delay_ms,
+                       "--jitter-ms", jitter_ms, "--loss", loss, "--ready-file", ready});
+    EXPECT_TRUE(
+        pump_until([&] { return std::filesystem::exists(ready) || !process->running(); }, 10.0) &&
+        process->running())
+        << "the relay (" << delay_ms << " ms, " << jitter_ms << " ms, " << loss
+        << ") did not come up";
+    return process;
+  };
 
   const std::string log_path = run_folder_ + "/device_side.lcm";
   test::ChildProcess logger(

@@ -6,17 +6,21 @@
 //
 //   stewart_netrelay --a 'udpm://239.255.77.2:7667?ttl=1' --b 'udpm://239.255.77.1:7667?ttl=1'
 //       [--delay-ms 2] [--jitter-ms 1] [--loss 0.01] [--seed 1] [--duration-s 0]
+//       [--ready-file PATH]
 //
 // Hosts on side a use group a, hosts on side b group b (each its own
-// --lcm-url). Stopping the relay is a partition. It prints one line per
-// direction when it stops (SIGINT/SIGTERM or --duration-s): offered,
-// delivered, lost, dropped for a full queue. docs/operations.md, "Several
-// hosts".
+// --lcm-url). Stopping the relay is a partition; to change the link without
+// one, start the new relay, wait for its --ready-file, then stop the old
+// one. It prints one line per direction when it stops (SIGINT/SIGTERM or
+// --duration-s): offered, delivered, lost, dropped for a full queue, and how
+// late it read what the kernel had received (its own stalls).
+// docs/operations.md, "Several hosts".
 #include <arpa/inet.h>
 #include <netinet/in.h>
 #include <poll.h>
 #include <spdlog/spdlog.h>
 #include <sys/socket.h>
+#include <time.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
@@ -25,6 +29,7 @@
 #include <chrono>
 #include <cstdio>
 #include <cstring>
+#include <fstream>
 #include <stdexcept>
 #include <string>
 
@@ -40,6 +45,21 @@ int64_t MonotonicUs() {
              std::chrono::steady_clock::now().time_since_epoch())
       .count();
 }
+
+int64_t RealtimeUs() {
+  timespec t{};
+  clock_gettime(CLOCK_REALTIME, &t);
+  return int64_t{t.tv_sec} * 1000000 + t.tv_nsec / 1000;
+}
+
+/// How late the relay read what the kernel had already received: the
+/// relay's own stalls, told apart from bursts that reached its socket
+/// together (a sender or the network stack held them).
+struct ReadLag {
+  int64_t max_lag_us = 0;     ///< kernel receipt to the relay's read
+  int64_t max_lag_at_us = 0;  ///< when (monotonic) the largest lag was seen
+  int64_t max_burst = 0;      ///< most datagrams read in one wake-up
+};
 
 sockaddr_in GroupAddress(const UdpmAddress& address) {
   sockaddr_in a{};
@@ -86,6 +106,9 @@ struct Side {
           "join " + address.group + " (is there a multicast route?)");
     const int rcvbuf = 4 << 20;
     setsockopt(rx.fd(), SOL_SOCKET, SO_RCVBUF, &rcvbuf, sizeof rcvbuf);
+    // The kernel's receipt time of each datagram: the delay counts from it,
+    // so a relay that wakes late does not add its lateness to the link's.
+    Check(setsockopt(rx.fd(), SOL_SOCKET, SO_TIMESTAMPNS, &one, sizeof one), "SO_TIMESTAMPNS");
 
     const auto ttl = static_cast<unsigned char>(address.ttl);
     Check(setsockopt(tx.fd(), IPPROTO_IP, IP_MULTICAST_TTL, &ttl, sizeof ttl), "IP_MULTICAST_TTL");
@@ -107,19 +130,47 @@ struct Side {
   Socket rx, tx;
   sockaddr_in own_source{};
   int64_t send_failures = 0;
+  ReadLag lag;
 };
 
-/// Reads every datagram waiting on `from` and offers the foreign ones to `link`.
+/// Reads every datagram waiting on `from` and offers the foreign ones to
+/// `link`, each at the monotonic time the kernel received it.
 void Drain(Side* from, ImpairedLink* link, std::array<uint8_t, 65536>* buffer) {
+  int64_t burst = 0;
   for (;;) {
     sockaddr_in source{};
-    socklen_t len = sizeof source;
-    const ssize_t n = recvfrom(from->rx.fd(), buffer->data(), buffer->size(), 0,
-                               reinterpret_cast<sockaddr*>(&source), &len);
-    if (n < 0) return;  // EAGAIN: nothing more now
+    iovec io{buffer->data(), buffer->size()};
+    alignas(cmsghdr) std::array<char, CMSG_SPACE(sizeof(timespec))> control{};
+    msghdr message{};
+    message.msg_name = &source;
+    message.msg_namelen = sizeof source;
+    message.msg_iov = &io;
+    message.msg_iovlen = 1;
+    message.msg_control = control.data();
+    message.msg_controllen = control.size();
+    const ssize_t n = recvmsg(from->rx.fd(), &message, 0);
+    if (n < 0) break;  // EAGAIN: nothing more now
+    const int64_t now_us = MonotonicUs();
+    int64_t lag_us = 0;
+    for (cmsghdr* c = CMSG_FIRSTHDR(&message); c != nullptr; c = CMSG_NXTHDR(&message, c)) {
+      if (c->cmsg_level == SOL_SOCKET && c->cmsg_type == SCM_TIMESTAMPNS) {
+        timespec received{};
+        std::memcpy(&received, CMSG_DATA(c), sizeof received);
+        const int64_t received_us = int64_t{received.tv_sec} * 1000000 + received.tv_nsec / 1000;
+        // A wall clock stepped under us gives a lag outside [0, 10 s]: ignored.
+        const int64_t lag = RealtimeUs() - received_us;
+        if (lag > 0 && lag < 10000000) lag_us = lag;
+      }
+    }
+    ++burst;
+    if (lag_us > from->lag.max_lag_us) {
+      from->lag.max_lag_us = lag_us;
+      from->lag.max_lag_at_us = now_us;
+    }
     if (from->IsOwn(source)) continue;
-    link->Offer(buffer->data(), static_cast<size_t>(n), MonotonicUs());
+    link->Offer(buffer->data(), static_cast<size_t>(n), now_us - lag_us);
   }
+  from->lag.max_burst = std::max(from->lag.max_burst, burst);
 }
 
 void Deliver(ImpairedLink* link, Side* to, int64_t now_us) {
@@ -131,13 +182,18 @@ void Deliver(ImpairedLink* link, Side* to, int64_t now_us) {
   });
 }
 
-void PrintDirection(const char* name, const ImpairedLinkCounters& c, int64_t send_failures) {
+void PrintDirection(const char* name, const ImpairedLinkCounters& c, int64_t send_failures,
+                    const ReadLag& lag, int64_t start_us) {
   std::printf(
       "stewart_netrelay: %s: offered %lld, delivered %lld, lost %lld, queue full %lld, send "
-      "failed %lld, most waiting %lld\n",
+      "failed %lld, most waiting %lld; read up to %.1f ms after the kernel had it (at %.2f s), "
+      "most read in one wake-up %lld\n",
       name, static_cast<long long>(c.offered), static_cast<long long>(c.delivered),
       static_cast<long long>(c.lost), static_cast<long long>(c.overflow),
-      static_cast<long long>(send_failures), static_cast<long long>(c.max_queued));
+      static_cast<long long>(send_failures), static_cast<long long>(c.max_queued),
+      1e-3 * static_cast<double>(lag.max_lag_us),
+      lag.max_lag_at_us > 0 ? 1e-6 * static_cast<double>(lag.max_lag_at_us - start_us) : 0.0,
+      static_cast<long long>(lag.max_burst));
 }
 
 struct Options {
@@ -145,6 +201,7 @@ struct Options {
   LinkImpairment impairment;
   uint32_t seed = 1;
   double duration_s = 0.0;
+  std::string ready_file;  ///< written once both groups are joined
 };
 
 int Run(const Options& options) {
@@ -160,7 +217,18 @@ int Run(const Options& options) {
                options.impairment.jitter_ms, options.impairment.loss);
   std::printf("stewart_netrelay: relaying\n");
   std::fflush(stdout);
+  if (!options.ready_file.empty()) {
+    // Written whole under another name, then renamed: a reader never sees
+    // a half-written file.
+    const std::string partial = options.ready_file + ".partial";
+    std::ofstream(partial) << "relaying\n";
+    if (std::rename(partial.c_str(), options.ready_file.c_str()) != 0) {
+      throw std::runtime_error("cannot write --ready-file " + options.ready_file + ": " +
+                               std::strerror(errno));
+    }
+  }
   std::array<uint8_t, 65536> buffer{};
+  const int64_t start_us = MonotonicUs();
   const int64_t end_us = options.duration_s > 0.0
                              ? MonotonicUs() + static_cast<int64_t>(options.duration_s * 1e6)
                              : INT64_MAX;
@@ -182,8 +250,8 @@ int Run(const Options& options) {
     Deliver(&a_to_b, &b, after_us);
     Deliver(&b_to_a, &a, after_us);
   }
-  PrintDirection("a->b", a_to_b.counters(), b.send_failures);
-  PrintDirection("b->a", b_to_a.counters(), a.send_failures);
+  PrintDirection("a->b", a_to_b.counters(), b.send_failures, a.lag, start_us);
+  PrintDirection("b->a", b_to_a.counters(), a.send_failures, b.lag, start_us);
   std::fflush(stdout);
   return 0;
 }
@@ -208,6 +276,8 @@ int main(int argc, char** argv) {
   app.add_option("--duration-s", options.duration_s,
                  "stop after this long (0: until SIGINT/SIGTERM)")
       ->check(CLI::Range(0.0, 1e7));
+  app.add_option("--ready-file", options.ready_file,
+                 "write this file once both groups are joined and datagrams flow");
   CLI11_PARSE(app, argc, argv);
   InstallStopSignalHandlers();
   try {
