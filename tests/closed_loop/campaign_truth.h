@@ -1,7 +1,8 @@
 #pragma once
 // One campaign run replayed in process from what `stewart_campaign --rerun
 // DIR --row R --emit-truth` wrote into config/truths/: the truth
-// (`name`.yaml), its setpoints (`name`-scenario.yaml) and the run's seed.
+// (`name`.yaml), its setpoints (`name`-scenario.yaml, or one of
+// config/scenarios/ by name for the fixed scenarios) and the run's seed.
 #include <gtest/gtest.h>
 
 #include <cstdint>
@@ -17,9 +18,11 @@ namespace stewart {
 namespace test {
 
 inline ClosedLoopSummary RunCampaignTruth(const StackConfig& config, const std::string& name,
-                                          uint64_t seed) {
+                                          uint64_t seed, const std::string& scenario_name = "") {
   const std::string truths = std::string(STEWART_SOURCE_DIR) + "/config/truths/";
-  const Scenario scenario = LoadScenario(truths + name + "-scenario.yaml");
+  const Scenario scenario =
+      LoadScenario(scenario_name.empty() ? truths + name + "-scenario.yaml"
+                                         : ResolveScenarioPath(scenario_name));
   ClosedLoopOptions options;
   options.seed = seed;
   options.truth = LoadPlantTruth(config, truths + name + ".yaml");

@@ -36,9 +36,12 @@ using test::kLimitTolerance;
 /// allowance".)
 ClosedLoopSummary RunCampaignTruth(StackConfig config, const std::string& name, uint64_t seed) {
   config.estimator.disturbance_friction_flip_std_n = 0.0;
-  std::printf("[force change] allowance std %.2f, cap %g N, friction-flip allowance off:\n",
-              config.estimator.disturbance_force_change_std,
-              config.estimator.disturbance_force_change_cap_n);
+  std::printf(
+      "[force change] allowance std %.2f, cap %g N, friction-flip allowance off, d re-opened "
+      "after %d samples:\n",
+      config.estimator.disturbance_force_change_std,
+      config.estimator.disturbance_force_change_cap_n,
+      config.estimator.disturbance_jump_after_samples);
   return test::RunCampaignTruth(config, name, seed);
 }
 
@@ -52,11 +55,22 @@ TEST(ForceChange, DryFrictionReversedByASetpointStepKeepsTheVelocityLimits) {
   test::ExpectHoldsOnlyWith(without_config, DefaultStackConfig(), RunReversal);
 }
 
+// The loop ran away while d re-opened only after 20 gated accelerometer
+// samples (the value the run was found with): 10 mm/s past the limit. With
+// the shipped 5 (docs/estimator.md, "Steps") the re-opening cuts it short,
+// but without the cap the run still breaks the tolerance.
 TEST(ForceChange, TheAllowanceDoesNotFeedTheFiltersMarginBack) {
   StackConfig uncapped_config = DefaultStackConfig();
   ASSERT_LT(uncapped_config.estimator.disturbance_force_change_cap_n, 10.0);
+  ASSERT_LT(uncapped_config.estimator.disturbance_jump_after_samples, 20);
   uncapped_config.estimator.disturbance_force_change_cap_n =
       std::numeric_limits<double>::infinity();
+  const ClosedLoopSummary uncapped_shipped =
+      RunCampaignTruth(uncapped_config, "bounds-force-change-loop", 1429968929u);
+  ASSERT_TRUE(uncapped_shipped.completed);
+  EXPECT_GT(uncapped_shipped.max_limit_excess, kLimitTolerance)
+      << uncapped_shipped.max_limit_excess_name;
+  uncapped_config.estimator.disturbance_jump_after_samples = 20;
   const ClosedLoopSummary uncapped =
       RunCampaignTruth(uncapped_config, "bounds-force-change-loop", 1429968929u);
   ASSERT_TRUE(uncapped.completed);
