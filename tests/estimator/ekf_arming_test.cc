@@ -105,10 +105,12 @@ TEST(EkfArming, AHeavierPlatformSinkingAtArmingIsFollowedWithoutARestart) {
 // `surplus_mps2`, damped as above), with the actuators applying the drive
 // two samples later than the model assumes: the two samples after the drive
 // comes on still show the legs held. Returns d_z's std after each of them
-// and d_z once the platform lifts.
+// and d_z once the platform lifts, on the last sample before the
+// accelerometer's disagreement re-opens d on its own (jump_after_samples
+// gated samples, docs/estimator.md "Steps").
 struct DriveOnRun {
   double std_z_after_first_n = 0.0, std_z_after_second_n = 0.0;
-  double d_z_once_lifting_n = 0.0;  ///< 3 samples after the drive acts
+  double d_z_once_lifting_n = 0.0;  ///< jump_after_samples - 1 samples after the drive acts
   int divergences = 0;
 };
 
@@ -120,6 +122,7 @@ DriveOnRun ArmLate(double allowance_s, double surplus_mps2) {
       EvaluateDynamics(c.platform, c.home_pose, Vector6d::Zero()), Vector6d::Zero());
   constexpr double kDt = 1e-3, kTau = 0.012;
   constexpr int kArm = 200, kLatency = 2, kEnd = 400;
+  const int lifting_samples = c.estimator.disturbance_jump_after_samples - 1;
   VerticalTruth truth{c.home_pose};
   DriveOnRun run;
   for (int k = 0; k < kEnd; ++k) {
@@ -130,20 +133,24 @@ DriveOnRun ArmLate(double allowance_s, double surplus_mps2) {
     ekf.SetForceCommand(s.utime, k < kArm ? Vector6d::Zero() : hover_n, k < kArm);
     if (k == kArm + 1) run.std_z_after_first_n = ekf.estimate().disturbance_std_n(2);
     if (k == kArm + 2) run.std_z_after_second_n = ekf.estimate().disturbance_std_n(2);
-    if (k == kArm + kLatency + 3) run.d_z_once_lifting_n = ekf.estimate().disturbance_n(2);
+    if (k == kArm + kLatency + lifting_samples)
+      run.d_z_once_lifting_n = ekf.estimate().disturbance_n(2);
   }
   std::printf(
       "[drive-on] allowance %.1f ms, surplus %.1f m/s^2: d_z std %.3f N, %.3f N after the two "
-      "held samples; d_z %.3f N 3 samples into the lift; %d restarts\n",
+      "held samples; d_z %.3f N %d samples into the lift; %d restarts\n",
       allowance_s * 1e3, surplus_mps2, run.std_z_after_first_n, run.std_z_after_second_n,
-      run.d_z_once_lifting_n, run.divergences);
+      run.d_z_once_lifting_n, lifting_samples, run.divergences);
   return run;
 }
 
 TEST(EkfArming, WhatTheSamplesBeforeTheDriveActsSayOfTheModelErrorIsDropped) {
   const double initial_std_n = DefaultStackConfig().estimator.initial_disturbance_std_n;
+  // The lift must be seen for at least one sample before the jump.
+  ASSERT_GE(DefaultStackConfig().estimator.disturbance_jump_after_samples, 2);
   // Without the allowance a held sample pins d at zero within one sample,
-  // and the lift that follows is not taken as model error...
+  // and the lift that follows is gated, not taken as model error, until the
+  // jump re-opens d...
   const DriveOnRun pinned = ArmLate(0.0, 3.0);
   EXPECT_LT(pinned.std_z_after_first_n, 0.5 * initial_std_n);
   EXPECT_LT(pinned.d_z_once_lifting_n, 0.1);
