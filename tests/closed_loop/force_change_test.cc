@@ -58,8 +58,8 @@ TEST(ForceChange, DryFrictionReversedByASetpointStepKeepsTheVelocityLimits) {
 // The loop ran away while d re-opened only after 20 gated accelerometer
 // samples (the value the run was found with): 10 mm/s past the limit; with
 // 5 (shipped until 2026-12-06) the re-opening cut it short, but the run
-// still broke the tolerance without the cap. With the shipped 3
-// (docs/estimator.md, "Steps") the re-opening alone holds this run; the cap
+// still broke the tolerance without the cap. With the shipped 2 (or 3,
+// docs/estimator.md, "Steps") the re-opening alone holds this run; the cap
 // stays as the bound on the loop's gain.
 TEST(ForceChange, TheAllowanceDoesNotFeedTheFiltersMarginBack) {
   StackConfig uncapped_config = DefaultStackConfig();

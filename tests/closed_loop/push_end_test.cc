@@ -36,7 +36,8 @@ TEST(PushEnd, ModelErrorReopensSoonEnoughToFollowAPushsEndWithoutARestart) {
   EXPECT_GE(before.estimator_reinits, 1);
   EXPECT_GT(before.max_limit_excess, 0.08);
   // After: followed, and the excess is what the step's first samples give
-  // (24 mm/s with d re-opened after 5 samples, 12 mm/s after the shipped 3).
+  // (24 mm/s with d re-opened after 5 samples, 12 after 3, 6 after the
+  // shipped 2).
   EXPECT_EQ(after.estimator_reinits, 0);
   EXPECT_LT(after.max_limit_excess, 0.03) << after.max_limit_excess_name;
   EXPECT_LT(after.max_limit_excess, 0.5 * before.max_limit_excess);

@@ -138,7 +138,7 @@ DriveOnRun ArmLate(double allowance_s, double surplus_mps2) {
   }
   std::printf(
       "[drive-on] allowance %.1f ms, surplus %.1f m/s^2: d_z std %.3f N, %.3f N after the two "
-      "held samples; d_z %.3f N %d samples into the lift; %d restarts\n",
+      "held samples; d_z %.3f N %d sample(s) into the lift; %d restarts\n",
       allowance_s * 1e3, surplus_mps2, run.std_z_after_first_n, run.std_z_after_second_n,
       run.d_z_once_lifting_n, lifting_samples, run.divergences);
   return run;

@@ -32,7 +32,7 @@ struct EstimatorConfig {
   double disturbance_jump_std_n = 5.0;
   double disturbance_jump_std_nm = 0.5;
   /// Consecutive gated accelerometer samples that make a jump.
-  int disturbance_jump_after_samples = 3;
+  int disturbance_jump_after_samples = 2;
   /// Relative std of what a change of the leg forces changes in d: d holds
   /// (M - M_true) qdd + H diag(gain - 1) F + ..., so an inertia the model
   /// lacks (a payload, its offset) and the legs' force gains move d with
