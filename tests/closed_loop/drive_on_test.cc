@@ -72,9 +72,9 @@ TEST(DriveOn, ModelErrorLearntFromAHeldSampleRestartsTheEstimate) {
   // held) pins the payload's torque at zero within one sample; the gyro is
   // then gated sample after sample while the platform rolls, and the legs
   // end in a restart. Shown with d re-opened after 20 gated accelerometer
-  // samples, the value this was found with: the shipped 5 re-open d's force
-  // rows soon enough to spare this run the restart even without either
-  // allowance (docs/estimator.md, "Steps").
+  // samples, the value this was found with: the shipped value (5 or fewer)
+  // re-opens d's force rows soon enough to spare this run the restart even
+  // without either allowance (docs/estimator.md, "Steps").
   StackConfig config = DefaultStackConfig();
   ASSERT_LT(config.estimator.disturbance_jump_after_samples, 20);
   config.estimator.command_latency_allowance_s = 0.0;
