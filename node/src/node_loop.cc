@@ -12,7 +12,13 @@ void ReportReceiverCounters(const LcmReceiver& receiver, HealthReporter* health)
   health->SetCounter("rx_decode_fail", receiver.counters().decode_failures);
   health->SetCounter("rx_incomplete", receiver.counters().incomplete_fragmented);
   health->SetCounter("rx_orphan_fragments", receiver.counters().orphan_fragments);
-  health->SetCounter("rx_kernel_drops", receiver.counters().kernel_drops);
+  // The kernel counts the datagrams its channel filter skipped (the other
+  // processes' channels) among a socket's drops: with the filter attached
+  // the count mixes those with what a full buffer lost, and goes out under a
+  // name that says so. Without it (a recorder) it is the buffer's losses.
+  health->SetCounter(
+      receiver.kernel_filter_attached() ? "rx_kernel_skipped_or_dropped" : "rx_kernel_drops",
+      receiver.counters().kernel_drops);
 }
 
 ExitCode RunNodeLoop(const std::string& name, lcm::LCM* lcm, LcmReceiver* receiver,

@@ -24,7 +24,9 @@
 #include "stewart/force_command_t.hpp"
 #include "stewart/health_t.hpp"
 #include "stewart/node/channel_filter.h"
+#include "stewart/node/health_reporter.h"
 #include "stewart/node/lcm_handle.h"
+#include "stewart/node/node_loop.h"
 #include "stewart/node/raw_bus_sender.h"
 
 namespace stewart {
@@ -414,6 +416,39 @@ TEST(LcmReceiver, CountsHostileDatagramsAndKeepsWorking) {
   EXPECT_EQ(receiver.counters().decode_failures, 1);
   EXPECT_EQ(receiver.counters().bad_datagrams, 3);
   EXPECT_EQ(receiver.counters().orphan_fragments, 1);
+}
+
+// The kernel counts the datagrams its channel filter skips among the
+// socket's drops (SO_RXQ_OVFL): a node's count then says nothing of a full
+// buffer, and its heartbeat names it for what it is.
+TEST(LcmReceiver, TheKernelCountsWhatItsFilterSkippedAmongTheDrops) {
+  const std::string url = PrivateLcmUrl(7811);
+  LcmReceiver receiver(url);
+  Sink sink;
+  receiver.Subscribe("CMD", &Sink::OnCommand, &sink);
+  ASSERT_TRUE(receiver.kernel_filter_attached());
+  auto lcm = MakeLcm(url);
+  force_command_t command{};
+  constexpr int kOthers = 20;
+  for (int i = 0; i < kOthers; ++i) lcm->publish("OTHER", &command);
+  command.seq = 7;
+  lcm->publish("CMD", &command);
+  PumpUntil(&receiver, [&] { return !sink.seqs.empty(); });
+  ASSERT_EQ(sink.seqs.size(), 1u);
+  // Nothing was lost (the buffer holds a few hundred of these), yet the
+  // kernel reports every skipped datagram as dropped.
+  EXPECT_EQ(receiver.counters().kernel_drops, kOthers);
+  HealthReporter health("test", "HEALTH", 1.0);
+  ReportReceiverCounters(receiver, &health);
+  EXPECT_EQ(health.counter("rx_kernel_skipped_or_dropped"), kOthers);
+  EXPECT_EQ(health.counter("rx_kernel_drops"), 0);
+  // A recorder (no filter) reports its count as the buffer's losses.
+  LcmReceiver recorder(url);
+  recorder.SubscribeAll([](const lcm::ReceiveBuffer&, const std::string&) {});
+  ASSERT_FALSE(recorder.kernel_filter_attached());
+  HealthReporter recorder_health("recorder", "HEALTH", 1.0);
+  ReportReceiverCounters(recorder, &recorder_health);
+  EXPECT_EQ(recorder_health.counter("rx_kernel_skipped_or_dropped"), 0);
 }
 
 // Minor page faults this thread has taken: pages it touched for the first

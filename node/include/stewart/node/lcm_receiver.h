@@ -59,9 +59,11 @@ struct LcmReceiverCounters {
   int64_t incomplete_fragmented = 0;  ///< fragmented messages given up (a fragment lost, too
                                       ///< old, or no room: see lcm_receiver.cc's bounds)
   int64_t orphan_fragments = 0;       ///< later fragments of a message whose first was not kept
-  /// Datagrams the kernel dropped since the socket opened because its buffer
-  /// was full (SO_RXQ_OVFL): lost unseen. The kernel stamps each datagram
-  /// with the drops before it, so a loss shows with the next datagram read.
+  /// Datagrams the kernel dropped since the socket opened (SO_RXQ_OVFL):
+  /// those lost unseen because its buffer was full and, while the channel
+  /// filter is attached, those the filter skipped (other channels): the
+  /// kernel counts both alike. The kernel stamps each datagram with the
+  /// drops before it, so a drop shows with the next datagram read.
   int64_t kernel_drops = 0;
 };
 
