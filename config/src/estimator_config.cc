@@ -60,6 +60,10 @@ EstimatorConfig ParseEstimatorConfig(const ConfigNode& estimator) {
     e.disturbance_jump_std_nm = d.NonNegativeDouble("jump_std_nm");
     e.disturbance_jump_after_samples =
         d.IntInRange("jump_after_samples", 1, INT_MAX, "must be >= 1");
+    if (d.Has("early_jump_calm_samples")) {
+      e.disturbance_early_jump_calm_samples =
+          d.IntInRange("early_jump_calm_samples", 0, INT_MAX, "must not be negative (0: off)");
+    }
     if (d.Has("force_change_std")) {
       e.disturbance_force_change_std = d.NonNegativeDouble("force_change_std");
     }

@@ -569,7 +569,7 @@ Vector6d Ekf::LatencyAccelerationError(const TimedCommand& command, int64_t inte
 template <int M, int NB>
 bool Ekf::Correct(const Eigen::Matrix<double, M, 1>& y, const std::array<int, NB>& blocks,
                   const Eigen::Matrix<double, M, 3 * NB>& h, const Eigen::Matrix<double, M, M>& R,
-                  double* nis) {
+                  double* nis, bool gate_only) {
   // P H^T and S = H P H^T + R from the non-zero blocks of H only.
   Eigen::Matrix<double, kEkfPaddedSize, M> pht;  // padding rows (if any): zero
   pht.noalias() =
@@ -598,6 +598,7 @@ bool Ekf::Correct(const Eigen::Matrix<double, M, 1>& y, const std::array<int, NB
   const Eigen::Matrix<double, M, 1> w_scaled = w.cwiseProduct(ldlt.inv_d);
   *nis = w.dot(w_scaled);
   if (!(*nis <= config_.gating_chi2)) return false;  // also rejects NaN
+  if (gate_only) return true;
   x_.noalias() += pht.template topRows<kEkfStateSize>() * w_scaled;
   // P -= G G^T with G = Z^T D^-1/2 (symmetric to the last bit).
   for (int k = 0; k < M; ++k) pht.col(k) *= std::sqrt(ldlt.inv_d(k));
@@ -757,13 +758,13 @@ void Ekf::CorrectAccel(const Vector3d& accel_mps2, const EulerAngleTrig& trig, u
   h << j.d_angles, j.d_rates, j.d_qdd * m_inv_, Matrix3d::Identity();
   const std::array<int, 5> blocks = {kEkfQ + 3, kEkfQd + 3, kEkfDisturbance, kEkfDisturbance + 3,
                                      kEkfAccelBias};
-  const auto correct = [&] {
+  const auto correct = [&](const Matrix3d& r, bool gate_only) {
     return EstimatesAccelBias()
-               ? Correct<3, 5>(y, blocks, h, R, &nis)
+               ? Correct<3, 5>(y, blocks, h, r, &nis, gate_only)
                : Correct<3, 4>(y, {blocks[0], blocks[1], blocks[2], blocks[3]},
-                               Eigen::Matrix<double, 3, 12>(h.leftCols<12>()), R, &nis);
+                               Eigen::Matrix<double, 3, 12>(h.leftCols<12>()), r, &nis, gate_only);
   };
-  if (correct()) {
+  if (correct(R, false)) {
     consecutive_accel_gated_ = 0;
     samples_since_accel_disagreed_ = std::min(samples_since_accel_disagreed_ + 1, kNeverDisagreed);
     return;
@@ -772,12 +773,30 @@ void Ekf::CorrectAccel(const Vector3d& accel_mps2, const EulerAngleTrig& trig, u
   if (samples_since_accel_disagreed_ > config_.disturbance_jump_after_samples) {
     accel_disagreement_start_utime_ = last_utime_;
   }
+  const int calm_samples = samples_since_accel_disagreed_;
   samples_since_accel_disagreed_ = 0;
+  // Jump on the first gated sample instead of the jump_after_samples-th
+  // when the accelerometer agreed for the calm samples before (no transient
+  // of earlier commands is under way) and the innovation stays beyond the
+  // gate whatever share of it a late command could explain (the latency
+  // allowance's direction l freed): the samples waited for would only
+  // confirm a step while it moves the platform unmodelled. Without the calm
+  // condition a jump that overshoots is followed by another, and d chatters.
+  const auto jumps_early = [&] {
+    const int calm_needed = config_.disturbance_early_jump_calm_samples;
+    if (calm_needed <= 0 || consecutive_accel_gated_ != 1 || calm_samples < calm_needed) {
+      return false;
+    }
+    const Vector3d l = j.d_qdd * latency_accel_;
+    const Matrix3d r_latency_freed = R + kLatencyDirectionFreed * (l * l.transpose());
+    return !correct(r_latency_freed, true);
+  };
   // Beyond the gate for long enough to be a step in d (a push, a payload set
   // down) that the random walk cannot follow, not the transient of a command
   // the actuators apply later than the model assumes: re-open d's
   // uncertainty and use the sample.
-  if (++consecutive_accel_gated_ < config_.disturbance_jump_after_samples) {
+  ++consecutive_accel_gated_;
+  if (consecutive_accel_gated_ < config_.disturbance_jump_after_samples && !jumps_early()) {
     *events |= kGateAccel;
     return;
   }
@@ -790,7 +809,7 @@ void Ekf::CorrectAccel(const Vector3d& accel_mps2, const EulerAngleTrig& trig, u
       P_.diagonal().segment<3>(kEkfDisturbance).cwiseMax(jump_n * jump_n);
   P_.diagonal().segment<3>(kEkfDisturbance + 3) =
       P_.diagonal().segment<3>(kEkfDisturbance + 3).cwiseMax(jump_nm * jump_nm);
-  if (correct()) {
+  if (correct(R, false)) {
     *events |= kEventDisturbanceJump;
   } else {
     *events |= kGateAccel;

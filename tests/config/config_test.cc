@@ -158,6 +158,20 @@ TEST(Config, ForceChangeAllowance) {
       "estimator.disturbance.force_change_cap_n", "positive");
 }
 
+TEST(Config, EarlyJump) {
+  const StackConfig c = LoadStackConfig(DefaultConfigPath());
+  EXPECT_EQ(c.estimator.disturbance_early_jump_calm_samples, 50);
+  YAML::Node yaml = DefaultYaml();
+  yaml["estimator"]["disturbance"].remove("early_jump_calm_samples");  // optional: off
+  EXPECT_EQ(ParseStackConfig(Emit(yaml)).estimator.disturbance_early_jump_calm_samples, 0);
+  ExpectConfigError(
+      [](YAML::Node& y) { y["estimator"]["disturbance"]["early_jump_calm_samples"] = -1; },
+      "estimator.disturbance.early_jump_calm_samples", "negative");
+  ExpectConfigError(
+      [](YAML::Node& y) { y["estimator"]["disturbance"]["early_jump_calm_samples"] = 2.5; },
+      "estimator.disturbance.early_jump_calm_samples", "integer");
+}
+
 TEST(Config, FrictionFlipAllowance) {
   const StackConfig c = LoadStackConfig(DefaultConfigPath());
   EXPECT_DOUBLE_EQ(c.estimator.disturbance_friction_flip_std_n, 0.1);

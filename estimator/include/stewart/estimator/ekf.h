@@ -66,11 +66,12 @@ class Ekf {
   /// Kalman correction with innovation `y` for a measurement whose Jacobian
   /// is non-zero only in the 3-column state blocks starting at `blocks`
   /// (`h` holds those blocks side by side); false (and no change) when the
-  /// innovation fails the gate.
+  /// innovation fails the gate. With `gate_only` the state is never changed:
+  /// only whether the innovation passes the gate.
   template <int M, int NB>
   bool Correct(const Eigen::Matrix<double, M, 1>& y, const std::array<int, NB>& blocks,
                const Eigen::Matrix<double, M, 3 * NB>& h, const Eigen::Matrix<double, M, M>& R,
-               double* nis);
+               double* nis, bool gate_only = false);
   bool LegsUsable(const SensorSample& sample, uint32_t* events) const;
   bool EstimatesAccelBias() const { return config_.initial_accel_bias_std_mps2 > 0.0; }
 
@@ -135,6 +136,11 @@ class Ekf {
   static constexpr double kMinReopenIntervalS = 0.5;
   std::optional<int64_t> pose_reopened_utime_;           ///< the latest re-opening
   int samples_since_accel_disagreed_ = kNeverDisagreed;  ///< gated or jumped
+  /// See CorrectAccel (disturbance_early_jump_calm_samples): the latency
+  /// allowance's term in the accelerometer's noise scaled by this (1000x its
+  /// std) frees the innovation along the direction a late command moves the
+  /// specific force, and nothing else.
+  static constexpr double kLatencyDirectionFreed = 1.0e6;
   int64_t accel_disagreement_start_utime_ = 0;  ///< first sample of the latest disagreement
   int samples_since_init_ = 0;
   /// The drive coming on (see Predict): d and its covariance as they were

@@ -33,6 +33,11 @@ struct EstimatorConfig {
   double disturbance_jump_std_nm = 0.5;
   /// Consecutive gated accelerometer samples that make a jump.
   int disturbance_jump_after_samples = 2;
+  /// A jump already on the first gated sample when the accelerometer agreed
+  /// for at least this many samples before and the innovation gates even
+  /// with the command latency allowance's direction freed
+  /// (docs/estimator.md, "Steps"). 0: off.
+  int disturbance_early_jump_calm_samples = 0;
   /// Relative std of what a change of the leg forces changes in d: d holds
   /// (M - M_true) qdd + H diag(gain - 1) F + ..., so an inertia the model
   /// lacks (a payload, its offset) and the legs' force gains move d with
