@@ -64,6 +64,9 @@ EstimatorConfig ParseEstimatorConfig(const ConfigNode& estimator) {
       e.disturbance_early_jump_calm_samples =
           d.IntInRange("early_jump_calm_samples", 0, INT_MAX, "must not be negative (0: off)");
     }
+    if (d.Has("early_jump_max_step_n")) {
+      e.disturbance_early_jump_max_step_n = d.PositiveDouble("early_jump_max_step_n");
+    }
     if (d.Has("force_change_std")) {
       e.disturbance_force_change_std = d.NonNegativeDouble("force_change_std");
     }

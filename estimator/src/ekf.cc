@@ -796,10 +796,22 @@ void Ekf::CorrectAccel(const Vector3d& accel_mps2, const EulerAngleTrig& trig, u
   // the actuators apply later than the model assumes: re-open d's
   // uncertainty and use the sample.
   ++consecutive_accel_gated_;
-  if (consecutive_accel_gated_ < config_.disturbance_jump_after_samples && !jumps_early()) {
+  const bool early = consecutive_accel_gated_ < config_.disturbance_jump_after_samples;
+  if (early && !jumps_early()) {
     *events |= kGateAccel;
     return;
   }
+  // One sample cannot tell a push from a bad reading (a glitch, a plant
+  // whose legs are not yet held at its start reads free fall): an early
+  // jump that moves d's force rows by more than any step the platform is
+  // specified for is undone and waits for the next sample, as without it.
+  EkfVector x_before_early_jump;
+  PaddedMatrix p_before_early_jump;
+  if (early) {
+    x_before_early_jump = x_;
+    p_before_early_jump = P_;
+  }
+  const int gated_before_jump = consecutive_accel_gated_;
   consecutive_accel_gated_ = 0;
   const double jump_n = config_.disturbance_jump_std_n;
   const double jump_nm = config_.disturbance_jump_std_nm;
@@ -809,11 +821,20 @@ void Ekf::CorrectAccel(const Vector3d& accel_mps2, const EulerAngleTrig& trig, u
       P_.diagonal().segment<3>(kEkfDisturbance).cwiseMax(jump_n * jump_n);
   P_.diagonal().segment<3>(kEkfDisturbance + 3) =
       P_.diagonal().segment<3>(kEkfDisturbance + 3).cwiseMax(jump_nm * jump_nm);
-  if (correct(R, false)) {
-    *events |= kEventDisturbanceJump;
-  } else {
+  if (!correct(R, false)) {
     *events |= kGateAccel;
+    return;
   }
+  if (early &&
+      (x_.segment<3>(kEkfDisturbance) - x_before_early_jump.segment<3>(kEkfDisturbance)).norm() >
+          config_.disturbance_early_jump_max_step_n) {
+    x_ = x_before_early_jump;
+    P_ = p_before_early_jump;
+    consecutive_accel_gated_ = gated_before_jump;
+    *events |= kGateAccel;
+    return;
+  }
+  *events |= kEventDisturbanceJump;
 }
 
 void Ekf::CorrectOrientation(const Vector3d& rpy_rad, uint32_t* events) {

@@ -170,6 +170,12 @@ TEST(Config, EarlyJump) {
   ExpectConfigError(
       [](YAML::Node& y) { y["estimator"]["disturbance"]["early_jump_calm_samples"] = 2.5; },
       "estimator.disturbance.early_jump_calm_samples", "integer");
+  EXPECT_DOUBLE_EQ(c.estimator.disturbance_early_jump_max_step_n, 6.0);
+  yaml["estimator"]["disturbance"].remove("early_jump_max_step_n");  // optional: no limit
+  EXPECT_TRUE(std::isinf(ParseStackConfig(Emit(yaml)).estimator.disturbance_early_jump_max_step_n));
+  ExpectConfigError(
+      [](YAML::Node& y) { y["estimator"]["disturbance"]["early_jump_max_step_n"] = 0.0; },
+      "estimator.disturbance.early_jump_max_step_n", "positive");
 }
 
 TEST(Config, FrictionFlipAllowance) {

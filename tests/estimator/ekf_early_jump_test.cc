@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <functional>
+#include <limits>
 #include <vector>
 
 #include "ekf_harness.h"
@@ -28,6 +29,7 @@ struct JumpRun {
   std::vector<int> jumps;        ///< samples flagged kEventDisturbanceJump
   std::vector<int> accel_gated;  ///< samples flagged kGateAccel
   int divergences = 0;
+  std::vector<double> d_force_n;  ///< |d's force rows| after each sample
   int FirstJumpFrom(int k) const {
     for (const int j : jumps) {
       if (j >= k) return j;
@@ -42,7 +44,8 @@ struct JumpRun {
 // `push(k, q)` is the external generalised force (N, N m) on the truth at
 // sample k.
 JumpRun RunHover(const StackConfig& c, int end_k, int step_k, double step_n, int latency_samples,
-            const std::function<Vector6d(int, const DynamicsTerms&)>& push) {
+                 const std::function<Vector6d(int, const DynamicsTerms&)>& push,
+                 const std::function<void(int, SensorSample*)>& edit_sample = {}) {
   Ekf ekf = test::MakeEkf(c);
   const Vector6d hover_n = InverseDynamics(
       EvaluateDynamics(c.platform, c.home_pose, Vector6d::Zero()), Vector6d::Zero());
@@ -55,7 +58,10 @@ JumpRun RunHover(const StackConfig& c, int end_k, int step_k, double step_n, int
     const Vector6d applied_n = k > step_k + latency_samples ? stepped_n : hover_n;
     const Vector6d friction_n = LegViscousFriction(damping_nspm, terms.H.transpose() * qd);
     const Vector6d qdd = ForwardDynamics(terms, applied_n + friction_n, push(k, terms));
-    const UpdateResult r = ekf.Update(test::NoiselessSample(c, k, false, q, qd, qdd));
+    SensorSample sample = test::NoiselessSample(c, k, false, q, qd, qdd);
+    if (edit_sample) edit_sample(k, &sample);
+    const UpdateResult r = ekf.Update(sample);
+    run.d_force_n.push_back(ekf.estimate().disturbance_n.head<3>().norm());
     if (r.Has(kEventDisturbanceJump)) run.jumps.push_back(k);
     if (r.Has(kGateAccel)) run.accel_gated.push_back(k);
     if (r.Has(kEventDiverged)) ++run.divergences;
@@ -117,17 +123,18 @@ TEST(EkfEarlyJump, AStepSoonAfterAnotherDisagreementWaitsForItsSecondSample) {
 }
 
 TEST(EkfEarlyJump, AnInnovationALateCommandCouldExplainWaitsForItsSecondSample) {
-  // A command step (0.3 N per leg) the actuators apply two samples late, and
-  // from its first sample a push along what the step adds (-4 H dF): the
-  // innovation lies along the direction the latency allowance answers, but
-  // beyond its size, so it gates; a late command of another size could
-  // explain it, and the EKF waits. The same push without the step (no
-  // latency direction) jumps at once.
+  // A command step (0.1 N per leg) the actuators apply two samples late, and
+  // from its first sample a push along what the step adds (-8 H dF, ~4.4 N,
+  // within the early jump's step limit): the innovation lies along the
+  // direction the latency allowance answers, but 9 times its size, so it
+  // gates; a late command of another size could explain it, and the EKF
+  // waits. The same push without the step (no latency direction) jumps at
+  // once.
   ASSERT_GT(DefaultStackConfig().estimator.command_latency_allowance_s, 0.0);
   static constexpr int kStep = 400, kEnd = 430;
-  static constexpr double kStepN = 0.3;
+  static constexpr double kStepN = 0.1;
   const auto push = [](int k, const DynamicsTerms& terms) {
-    return k > kStep ? Vector6d(-4.0 * terms.H * Vector6d::Constant(kStepN))
+    return k > kStep ? Vector6d(-8.0 * terms.H * Vector6d::Constant(kStepN))
                      : Vector6d(Vector6d::Zero());
   };
   const JumpRun late_step = RunHover(DefaultStackConfig(), kEnd, kStep, kStepN, 2, push);
@@ -141,6 +148,40 @@ TEST(EkfEarlyJump, AnInnovationALateCommandCouldExplainWaitsForItsSecondSample) 
   EXPECT_EQ(late_step.FirstJumpFrom(0),
             kStep + DefaultStackConfig().estimator.disturbance_jump_after_samples);
   EXPECT_EQ(steady.FirstJumpFrom(0), kStep + 1);
+}
+
+TEST(EkfEarlyJump, OneSampleBeyondAnyPushWaitsForTheNext) {
+  // One accelerometer sample reads free fall (no specific force: a glitch,
+  // or a plant started with its legs not yet held) on a calm platform at
+  // rest. The next samples agree again: nothing happened.
+  constexpr int kGlitch = 400, kEnd = 430;
+  const auto no_push = [](int, const DynamicsTerms&) { return Vector6d(Vector6d::Zero()); };
+  const auto free_fall = [](int k, SensorSample* s) {
+    if (k == kGlitch) s->accel_mps2.setZero();
+  };
+  const StackConfig& shipped_config = DefaultStackConfig();
+  ASSERT_LT(shipped_config.estimator.disturbance_early_jump_max_step_n, 9.0);
+  const JumpRun shipped = RunHover(shipped_config, kEnd, kEnd, 0.0, 0, no_push, free_fall);
+  StackConfig unlimited_config = DefaultStackConfig();
+  unlimited_config.estimator.disturbance_early_jump_max_step_n =
+      std::numeric_limits<double>::infinity();
+  const JumpRun unlimited = RunHover(unlimited_config, kEnd, kEnd, 0.0, 0, no_push, free_fall);
+  std::printf(
+      "[early jump] one free-fall sample at rest: |d| %.2f N after it, %.2f N at the end (%zu "
+      "jumps); without the step limit %.2f N after it (%zu jumps, the first at %d), %.2f N at "
+      "the end\n",
+      shipped.d_force_n[kGlitch], shipped.d_force_n.back(), shipped.jumps.size(),
+      unlimited.d_force_n[kGlitch], unlimited.jumps.size(), unlimited.FirstJumpFrom(0),
+      unlimited.d_force_n.back());
+  // The limit undoes the jump: the sample is only gated and d stays put.
+  EXPECT_TRUE(shipped.jumps.empty());
+  EXPECT_LT(shipped.d_force_n[kGlitch], 0.1);
+  EXPECT_LT(shipped.d_force_n.back(), 0.1);
+  // Without it the sample is taken as a step of ~9 N, which the next
+  // samples take back only through another jump.
+  EXPECT_EQ(unlimited.FirstJumpFrom(0), kGlitch);
+  EXPECT_GT(unlimited.d_force_n[kGlitch],
+            shipped_config.estimator.disturbance_early_jump_max_step_n);
 }
 
 }  // namespace

@@ -38,6 +38,11 @@ struct EstimatorConfig {
   /// with the command latency allowance's direction freed
   /// (docs/estimator.md, "Steps"). 0: off.
   int disturbance_early_jump_calm_samples = 0;
+  /// An early jump that moves d's force rows by more than this (N, norm) is
+  /// undone: one sample cannot tell a push from a bad reading, and a step
+  /// beyond the largest push the platform is specified for waits for the
+  /// next sample. Infinite: no limit.
+  double disturbance_early_jump_max_step_n = std::numeric_limits<double>::infinity();
   /// Relative std of what a change of the leg forces changes in d: d holds
   /// (M - M_true) qdd + H diag(gain - 1) F + ..., so an inertia the model
   /// lacks (a payload, its offset) and the legs' force gains move d with
