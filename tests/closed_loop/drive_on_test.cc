@@ -75,10 +75,13 @@ TEST(DriveOn, ModelErrorLearntFromAHeldSampleRestartsTheEstimate) {
   // samples, the value this was found with: the shipped value (5 or fewer)
   // re-opens d's force rows soon enough to spare this run the restart even
   // without either allowance (docs/estimator.md, "Steps").
+  // The early jump is off too: without the allowance it cannot tell a late
+  // command from a step, and it came after this was found.
   StackConfig config = DefaultStackConfig();
   ASSERT_LT(config.estimator.disturbance_jump_after_samples, 20);
   config.estimator.command_latency_allowance_s = 0.0;
   config.estimator.disturbance_force_change_std = 0.0;
+  config.estimator.disturbance_early_jump_calm_samples = 0;
   StackConfig late_jump = config;
   late_jump.estimator.disturbance_jump_after_samples = 20;
   const ClosedLoopSummary without = Arm(late_jump, "bounds-offcentre-payload.yaml");

@@ -160,7 +160,7 @@ TEST(Config, ForceChangeAllowance) {
 
 TEST(Config, EarlyJump) {
   const StackConfig c = LoadStackConfig(DefaultConfigPath());
-  EXPECT_EQ(c.estimator.disturbance_early_jump_calm_samples, 50);
+  EXPECT_EQ(c.estimator.disturbance_early_jump_calm_samples, 0);  // off: docs/estimator.md
   YAML::Node yaml = DefaultYaml();
   yaml["estimator"]["disturbance"].remove("early_jump_calm_samples");  // optional: off
   EXPECT_EQ(ParseStackConfig(Emit(yaml)).estimator.disturbance_early_jump_calm_samples, 0);

@@ -79,6 +79,13 @@ StackConfig WithEarlyJump(int calm_samples) {
   return c;
 }
 
+// The early jump as measured in the campaigns (docs/campaign.md): 50 calm
+// samples and the config's step limit (the config ships it off).
+const StackConfig& EarlyJumpConfig() {
+  static const StackConfig c = WithEarlyJump(50);
+  return c;
+}
+
 // 3 N along x from sample `from_k` on (through {P}'s origin: a force alone).
 Vector6d PushX(int k, int from_k) {
   Vector6d q_push = Vector6d::Zero();
@@ -88,30 +95,29 @@ Vector6d PushX(int k, int from_k) {
 
 TEST(EkfEarlyJump, APushOnACalmPlatformJumpsOnItsFirstGatedSample) {
   ASSERT_GE(DefaultStackConfig().estimator.disturbance_jump_after_samples, 2);
-  ASSERT_GT(DefaultStackConfig().estimator.disturbance_early_jump_calm_samples, 0);
   constexpr int kPush = 400, kEnd = 430;
   const auto push = [](int k, const DynamicsTerms&) { return PushX(k, kPush); };
-  const JumpRun shipped = RunHover(DefaultStackConfig(), kEnd, kEnd, 0.0, 0, push);
+  const JumpRun early = RunHover(EarlyJumpConfig(), kEnd, kEnd, 0.0, 0, push);
   const JumpRun off = RunHover(WithEarlyJump(0), kEnd, kEnd, 0.0, 0, push);
   std::printf("[early jump] a 3 N push at sample %d: jump at %d (early jump off: %d)\n", kPush,
-              shipped.FirstJumpFrom(0), off.FirstJumpFrom(0));
-  EXPECT_EQ(shipped.FirstJumpFrom(0), kPush);
+              early.FirstJumpFrom(0), off.FirstJumpFrom(0));
+  EXPECT_EQ(early.FirstJumpFrom(0), kPush);
   EXPECT_EQ(off.FirstJumpFrom(0),
             kPush + DefaultStackConfig().estimator.disturbance_jump_after_samples - 1);
-  EXPECT_EQ(shipped.divergences, 0);
+  EXPECT_EQ(early.divergences, 0);
   EXPECT_EQ(off.divergences, 0);
 }
 
 TEST(EkfEarlyJump, AStepSoonAfterAnotherDisagreementWaitsForItsSecondSample) {
   // The push grows from 3 N to 6 N 20 samples after it began: the
   // accelerometer disagreed too lately for the calm condition.
-  const int calm = DefaultStackConfig().estimator.disturbance_early_jump_calm_samples;
+  const int calm = EarlyJumpConfig().estimator.disturbance_early_jump_calm_samples;
   constexpr int kPush = 400, kGrow = 420, kEnd = 440;
   ASSERT_LT(kGrow - kPush, calm);
   const auto push = [](int k, const DynamicsTerms&) {
     return Vector6d(PushX(k, kPush) + PushX(k, kGrow));
   };
-  const JumpRun run = RunHover(DefaultStackConfig(), kEnd, kEnd, 0.0, 0, push);
+  const JumpRun run = RunHover(EarlyJumpConfig(), kEnd, kEnd, 0.0, 0, push);
   std::printf("[early jump] the push grows at sample %d: jump at %d\n", kGrow,
               run.FirstJumpFrom(kGrow));
   EXPECT_EQ(run.FirstJumpFrom(kPush), kPush);
@@ -137,8 +143,8 @@ TEST(EkfEarlyJump, AnInnovationALateCommandCouldExplainWaitsForItsSecondSample) 
     return k > kStep ? Vector6d(-8.0 * terms.H * Vector6d::Constant(kStepN))
                      : Vector6d(Vector6d::Zero());
   };
-  const JumpRun late_step = RunHover(DefaultStackConfig(), kEnd, kStep, kStepN, 2, push);
-  const JumpRun steady = RunHover(DefaultStackConfig(), kEnd, kEnd, 0.0, 0, push);
+  const JumpRun late_step = RunHover(EarlyJumpConfig(), kEnd, kStep, kStepN, 2, push);
+  const JumpRun steady = RunHover(EarlyJumpConfig(), kEnd, kEnd, 0.0, 0, push);
   std::printf(
       "[early jump] a push along a late step's direction from sample %d: jump at %d; without the "
       "step: %d\n",
@@ -159,10 +165,10 @@ TEST(EkfEarlyJump, OneSampleBeyondAnyPushWaitsForTheNext) {
   const auto free_fall = [](int k, SensorSample* s) {
     if (k == kGlitch) s->accel_mps2.setZero();
   };
-  const StackConfig& shipped_config = DefaultStackConfig();
-  ASSERT_LT(shipped_config.estimator.disturbance_early_jump_max_step_n, 9.0);
-  const JumpRun shipped = RunHover(shipped_config, kEnd, kEnd, 0.0, 0, no_push, free_fall);
-  StackConfig unlimited_config = DefaultStackConfig();
+  const StackConfig& limited_config = EarlyJumpConfig();
+  ASSERT_LT(limited_config.estimator.disturbance_early_jump_max_step_n, 9.0);
+  const JumpRun limited = RunHover(limited_config, kEnd, kEnd, 0.0, 0, no_push, free_fall);
+  StackConfig unlimited_config = EarlyJumpConfig();
   unlimited_config.estimator.disturbance_early_jump_max_step_n =
       std::numeric_limits<double>::infinity();
   const JumpRun unlimited = RunHover(unlimited_config, kEnd, kEnd, 0.0, 0, no_push, free_fall);
@@ -170,18 +176,18 @@ TEST(EkfEarlyJump, OneSampleBeyondAnyPushWaitsForTheNext) {
       "[early jump] one free-fall sample at rest: |d| %.2f N after it, %.2f N at the end (%zu "
       "jumps); without the step limit %.2f N after it (%zu jumps, the first at %d), %.2f N at "
       "the end\n",
-      shipped.d_force_n[kGlitch], shipped.d_force_n.back(), shipped.jumps.size(),
+      limited.d_force_n[kGlitch], limited.d_force_n.back(), limited.jumps.size(),
       unlimited.d_force_n[kGlitch], unlimited.jumps.size(), unlimited.FirstJumpFrom(0),
       unlimited.d_force_n.back());
   // The limit undoes the jump: the sample is only gated and d stays put.
-  EXPECT_TRUE(shipped.jumps.empty());
-  EXPECT_LT(shipped.d_force_n[kGlitch], 0.1);
-  EXPECT_LT(shipped.d_force_n.back(), 0.1);
+  EXPECT_TRUE(limited.jumps.empty());
+  EXPECT_LT(limited.d_force_n[kGlitch], 0.1);
+  EXPECT_LT(limited.d_force_n.back(), 0.1);
   // Without it the sample is taken as a step of ~9 N, which the next
   // samples take back only through another jump.
   EXPECT_EQ(unlimited.FirstJumpFrom(0), kGlitch);
   EXPECT_GT(unlimited.d_force_n[kGlitch],
-            shipped_config.estimator.disturbance_early_jump_max_step_n);
+            limited_config.estimator.disturbance_early_jump_max_step_n);
 }
 
 }  // namespace
