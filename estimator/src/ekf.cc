@@ -811,7 +811,6 @@ void Ekf::CorrectAccel(const Vector3d& accel_mps2, const EulerAngleTrig& trig, u
     x_before_early_jump = x_;
     p_before_early_jump = P_;
   }
-  const int gated_before_jump = consecutive_accel_gated_;
   consecutive_accel_gated_ = 0;
   const double jump_n = config_.disturbance_jump_std_n;
   const double jump_nm = config_.disturbance_jump_std_nm;
@@ -830,7 +829,7 @@ void Ekf::CorrectAccel(const Vector3d& accel_mps2, const EulerAngleTrig& trig, u
           config_.disturbance_early_jump_max_step_n) {
     x_ = x_before_early_jump;
     P_ = p_before_early_jump;
-    consecutive_accel_gated_ = gated_before_jump;
+    consecutive_accel_gated_ = 1;  // the first gated sample, as without the early jump
     *events |= kGateAccel;
     return;
   }
