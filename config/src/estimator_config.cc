@@ -13,6 +13,9 @@ EstimatorConfig ParseEstimatorConfig(const ConfigNode& estimator) {
   e.process_accel_std_mps2 = estimator.PositiveDouble("process_accel_std_mps2");
   e.process_angaccel_std_radps2 = estimator.PositiveDouble("process_angaccel_std_radps2");
   e.dynamics_accel_std_mps2 = estimator.PositiveDouble("dynamics_accel_std_mps2");
+  if (estimator.Has("accel_update_dynamics_std_mps2")) {
+    e.accel_update_dynamics_std_mps2 = estimator.PositiveDouble("accel_update_dynamics_std_mps2");
+  }
   e.dynamics_angaccel_std_radps2 = estimator.PositiveDouble("dynamics_angaccel_std_radps2");
   e.gyro_bias_walk_radps_per_sqrt_s =
       estimator.NonNegativeDouble("gyro_bias_walk_radps_per_sqrt_s");

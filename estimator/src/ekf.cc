@@ -29,6 +29,12 @@ double HoldTimeConstant(const ActuatorConfig& actuators) {
                   kMinHoldTimeConstantS);
 }
 
+// The dynamics model's acceleration std in the accelerometer's update (m/s^2).
+double AccelUpdateDynamicsStd(const EstimatorConfig& config) {
+  return config.accel_update_dynamics_std_mps2 > 0.0 ? config.accel_update_dynamics_std_mps2
+                                                     : config.dynamics_accel_std_mps2;
+}
+
 // Discrete white-noise acceleration (one sample of constant acceleration with
 // std sigma) on the (q_i, qd_i) pair of axis i.
 template <typename Matrix>
@@ -715,7 +721,7 @@ void Ekf::CorrectAccel(const Vector3d& accel_mps2, const EulerAngleTrig& trig, u
   predicted += x_.segment<3>(kEkfAccelBias);
   // The predicted qdd is uncertain by the process model's acceleration noise.
   const double sigma =
-      qdd_from_dynamics_ ? config_.dynamics_accel_std_mps2 : config_.process_accel_std_mps2;
+      qdd_from_dynamics_ ? AccelUpdateDynamicsStd(config_) : config_.process_accel_std_mps2;
   Matrix3d R = Matrix3d::Identity() * (accel_variance_ + sigma * sigma);
   if (qdd_from_dynamics_) {
     // ... and by the state's: the dynamics model's qdd depends on q and qd

@@ -247,7 +247,12 @@ std::size_t HwBridge::BuildCommandFrame(int64_t host_now_us, uint8_t* out) {
       counters_.force_deadzoned += (drive.deadzone_mask >> i) & 1U;
     }
   } else {
-    // Zero drive: the P-16P's lead screw holds its length unpowered.
+    // Zero drive: the P-16P's lead screw holds its length unpowered. ENABLE
+    // clear, so the device's samples say the actuators are off (status
+    // ACTUATORS_OFF) while this frame is in force: the estimator then
+    // predicts the legs held instead of moved by the last safe command,
+    // which did not reach them.
+    frame.flags = 0;
     frame.drive.fill(0);
     ++counters_.zero_drive_frames;
     if (last_reason_ == DriveReason::kDriveOff) ++counters_.drive_off_frames;

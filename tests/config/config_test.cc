@@ -158,9 +158,23 @@ TEST(Config, ForceChangeAllowance) {
       "estimator.disturbance.force_change_cap_n", "positive");
 }
 
+TEST(Config, AccelUpdateDynamicsStd) {
+  // Optional: unset, the accelerometer's update takes the velocity's process
+  // noise (dynamics_accel_std_mps2); the P-16P overlay sets it apart.
+  EXPECT_LT(LoadStackConfig(DefaultConfigPath()).estimator.accel_update_dynamics_std_mps2, 0.0);
+  YAML::Node yaml = DefaultYaml();
+  yaml["estimator"]["accel_update_dynamics_std_mps2"] = 0.1;
+  EXPECT_DOUBLE_EQ(ParseStackConfig(Emit(yaml)).estimator.accel_update_dynamics_std_mps2, 0.1);
+  ExpectConfigError([](YAML::Node& y) { y["estimator"]["accel_update_dynamics_std_mps2"] = 0.0; },
+                    "estimator.accel_update_dynamics_std_mps2", "positive");
+  ExpectConfigError(
+      [](YAML::Node& y) { y["estimator"]["accel_update_dynamics_std_mps2"] = "wide"; },
+      "estimator.accel_update_dynamics_std_mps2", "number");
+}
+
 TEST(Config, EarlyJump) {
   const StackConfig c = LoadStackConfig(DefaultConfigPath());
-  EXPECT_EQ(c.estimator.disturbance_early_jump_calm_samples, 0);  // off: docs/estimator.md
+  EXPECT_EQ(c.estimator.disturbance_early_jump_calm_samples, 50);  // docs/estimator.md, "Steps"
   YAML::Node yaml = DefaultYaml();
   yaml["estimator"]["disturbance"].remove("early_jump_calm_samples");  // optional: off
   EXPECT_EQ(ParseStackConfig(Emit(yaml)).estimator.disturbance_early_jump_calm_samples, 0);

@@ -79,8 +79,9 @@ StackConfig WithEarlyJump(int calm_samples) {
   return c;
 }
 
-// The early jump as measured in the campaigns (docs/campaign.md): 50 calm
-// samples and the config's step limit (the config ships it off).
+// The early jump as shipped and measured in the campaigns (docs/campaign.md):
+// 50 calm samples (Config.EarlyJump pins the shipped value) and the
+// config's step limit.
 const StackConfig& EarlyJumpConfig() {
   static const StackConfig c = WithEarlyJump(50);
   return c;

@@ -98,6 +98,9 @@ TEST_F(BridgeTest, MissingCommandGivesZeroDrive) {
   const DecodedFrame f = Send();
   EXPECT_EQ(bridge_.last_reason(), DriveReason::kMissing);
   for (int16_t d : f.command.drive) EXPECT_EQ(d, 0);
+  // ENABLE clear: the device's samples say the actuators are off, so the
+  // estimator predicts the legs held, not moved by a command.
+  EXPECT_EQ(f.command.flags & kCommandEnable, 0);
   EXPECT_EQ(f.command.watchdog_us, static_cast<uint32_t>(hw_.device_watchdog_s * 1e6));
   EXPECT_EQ(bridge_.counters().zero_drive_frames, 1U);
 }
@@ -111,6 +114,7 @@ TEST_F(BridgeTest, FreshCommandIsMappedAndStaleOneZeroed) {
   EXPECT_EQ(bridge_.last_reason(), DriveReason::kCommand);
   const DriveResult expected = DriveMap(hw_, 100.0).ForceToDrive(force);
   EXPECT_EQ(f.command.drive, expected.drive);
+  EXPECT_NE(f.command.flags & kCommandEnable, 0);
   // The stack's time moves on (new samples) but no new command: stale after
   // command_timeout_s of sample time, whatever the wall clock does.
   const auto timeout_ms = static_cast<uint32_t>(hw_.command_timeout_s * 1e3);
@@ -121,6 +125,7 @@ TEST_F(BridgeTest, FreshCommandIsMappedAndStaleOneZeroed) {
   f = Send();
   EXPECT_EQ(bridge_.last_reason(), DriveReason::kStale);
   for (int16_t d : f.command.drive) EXPECT_EQ(d, 0);
+  EXPECT_EQ(f.command.flags & kCommandEnable, 0);
 }
 
 // A bridge that was not running (SIGSTOP, a starved CPU) reads the device's
@@ -137,6 +142,7 @@ TEST_F(BridgeTest, AfterAStallAQueuedFrameDoesNotMakeAnOldCommandYoung) {
   const DecodedFrame f = Send();
   EXPECT_EQ(bridge_.last_reason(), DriveReason::kStale);
   for (int16_t d : f.command.drive) EXPECT_EQ(d, 0);
+  EXPECT_EQ(f.command.flags & kCommandEnable, 0);
 }
 
 TEST_F(BridgeTest, ForcesInTheDeadZoneAreCounted) {
@@ -322,6 +328,7 @@ TEST_F(BridgeTest, ZeroDriveUntilTheDeviceFollowsTheSession) {
     const DecodedFrame f = Send();
     EXPECT_EQ(bridge_.last_reason(), DriveReason::kSessionPending) << other;
     for (int16_t d : f.command.drive) EXPECT_EQ(d, 0);
+    EXPECT_EQ(f.command.flags & kCommandEnable, 0);
     EXPECT_EQ(bridge_.device_session(), other);
     const LinkHealth h = bridge_.Health(host_now_, "udp test");
     EXPECT_EQ(h.state, LinkState::kDegraded);
@@ -338,6 +345,7 @@ TEST_F(BridgeTest, ZeroDriveUntilTheDeviceFollowsTheSession) {
   const DecodedFrame f = Send();
   EXPECT_EQ(bridge_.last_reason(), DriveReason::kCommand);
   EXPECT_EQ(f.command.drive, DriveMap(hw_, 100.0).ForceToDrive(Vector6d::Constant(20.0)).drive);
+  EXPECT_NE(f.command.flags & kCommandEnable, 0);
   // The device stops following it (rebooted: no session): zero drive at once.
   device_session_ = 0U;
   Deliver(k++);

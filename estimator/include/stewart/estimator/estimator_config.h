@@ -17,8 +17,16 @@ struct EstimatorConfig {
   /// std of the acceleration, white over one sample (m/s^2, rad/s^2).
   double process_accel_std_mps2 = 0.2;
   double process_angaccel_std_radps2 = 0.5;
-  /// Dynamics model: std of the model error as an acceleration.
+  /// Dynamics model: std of the model error as an acceleration (m/s^2),
+  /// white over one sample: the velocity's process noise.
   double dynamics_accel_std_mps2 = 0.001;
+  /// The same model error as the accelerometer's update sees it: the std of
+  /// the predicted translational acceleration added to the accelerometer's
+  /// noise (m/s^2). Negative: dynamics_accel_std_mps2. Apart because the
+  /// legs' corrections need the velocity's process noise while a larger
+  /// share here widens d's uncertainty, and so the filter's margin
+  /// (docs/estimator.md, "The P-16P legs").
+  double accel_update_dynamics_std_mps2 = -1.0;
   double dynamics_angaccel_std_radps2 = 0.01;
   /// Model error d (docs/estimator.md, "Model error"): estimated with the
   /// dynamics model only. A random walk (per sqrt(s)), its initial std, and
