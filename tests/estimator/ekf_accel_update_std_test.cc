@@ -67,7 +67,7 @@ TEST(EkfAccelUpdateStd, OnlyTheAccelerometersShareWidensTheModelErrorsStd) {
   Print("accelerometer's share x4", wider_share);
   Print("process noise x4, share kept", more_process);
   // The accelerometer is what tells d: a less trusted prediction leaves d
-  // less certain, and the filter's margin (3 std) wider.
+  // less certain, and the filter's margin (disturbance_sigma std) wider.
   EXPECT_GT(wider_share.mean_d_std_n, 1.5 * base.mean_d_std_n);
   // The velocity's process noise alone leaves d's std where it was ...
   EXPECT_NEAR(more_process.mean_d_std_n, base.mean_d_std_n, 0.1 * base.mean_d_std_n);
