@@ -13,6 +13,7 @@
 
 #include "stewart/config/config_loader.h"
 #include "stewart/config/default_config.h"
+#include "stewart/config/truth_loader.h"
 #include "stewart/stack/campaign_summary.h"
 
 namespace stewart {
@@ -152,6 +153,12 @@ TEST_F(CampaignCli, IdentifyActuatorsRunsOnTheIdentifiedMotors) {
     EXPECT_EQ(row[completed], "1");
     EXPECT_EQ(row[failure], "");
   }
+  // The emitted truth names the legs' model: given with the base config (a
+  // truth overrides the file, not the overlays), it is still this plant.
+  ASSERT_EQ(Shell(bin_ + " --rerun " + folder + " --row 1 --emit-truth > " + out + " 2>&1"), 0)
+      << ReadText(out);
+  EXPECT_EQ(LoadPlantTruth(DefaultStackConfig(), folder + "/run_1_truth.yaml").actuators.kind,
+            ActuatorKind::kDcMotor);
   EXPECT_EQ(Shell(bin_ + " --runs 2 --identify-actuators --out " + dir_ + "/e > " + out + " 2>&1"),
             2);
   EXPECT_NE(ReadText(out).find("--identify-actuators"), std::string::npos) << ReadText(out);

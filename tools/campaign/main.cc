@@ -231,10 +231,19 @@ int Rerun(const std::string& dir, long row_number, bool emit_truth) {
               FormatSummary(spec.config, row.summary).c_str());
   if (emit_truth) {
     const RunSetup setup = SetUpRun(spec, index);
+    // A truth overrides the config file a plant is given, not its overlays
+    // (docs/simulation.md, "Truth"): name the legs' model so that the file
+    // gives the same plant with the base config and an overlay such as
+    // config/overlays/p16p.yaml.
+    YAML::Node truth_yaml = YAML::Clone(setup.truth_yaml);
+    const YAML::Node& config_root = spec.config_root;
+    if (config_root["actuators"]["model"] && !truth_yaml["actuators"]["model"]) {
+      truth_yaml["actuators"]["model"] = config_root["actuators"]["model"].as<std::string>();
+    }
     std::ostringstream truth;
     truth << "# The plant of campaign run " << index << " (seed " << setup.seed
           << "): plant_sim --truth / tools/launch.sh --truth\n"
-          << setup.truth_yaml << "\n";
+          << truth_yaml << "\n";
     WriteText(stem + "_truth.yaml", truth.str());
     std::string scenario = spec.scenario;
     if (!setup.scenario_yaml.IsNull()) {
