@@ -40,6 +40,19 @@ TEST(TruthLoader, TheBoundsCornersLoad) {
   EXPECT_LT(light.platform.platform_mass_kg, 0.85 * Config().platform.platform_mass_kg);
   EXPECT_NEAR(heavy.latency.total_s(), 0.002, 1e-12);
   EXPECT_NEAR(light.latency.total_s(), 0.002, 1e-12);
+
+  // The P-16P corners name their legs: over the base config (a truth
+  // overrides the file, not an overlay) the plant's legs are DC motors,
+  // with the motors at the +-5 % corners.
+  const PlantTruth p16p_heavy = LoadPlantTruth(Config(), dir + "bounds-p16p-heavy-corner.yaml");
+  const PlantTruth p16p_light = LoadPlantTruth(Config(), dir + "bounds-p16p-light-corner.yaml");
+  EXPECT_EQ(p16p_heavy.actuators.kind, ActuatorKind::kDcMotor);
+  EXPECT_EQ(p16p_light.actuators.kind, ActuatorKind::kDcMotor);
+  EXPECT_EQ(p16p_heavy.platform.platform_mass_kg, heavy.platform.platform_mass_kg);
+  EXPECT_EQ(p16p_light.platform.platform_mass_kg, light.platform.platform_mass_kg);
+  const DcMotorParams& nominal = Config().actuators.motor;
+  EXPECT_NEAR(p16p_heavy.actuators.motor.stall_force_n / nominal.stall_force_n, 0.95, 1e-12);
+  EXPECT_NEAR(p16p_light.actuators.motor.stall_force_n / nominal.stall_force_n, 1.05, 1e-12);
 }
 
 TEST(TruthLoader, OverridesKeyByKeyAndKeepsTheRest) {

@@ -28,10 +28,11 @@ namespace {
 
 struct StackCase {
   const char* scenario;
-  int lcm_port;            // this file's private ports: 7820-7829
-  double duration_s;       // simulated seconds
-  double min_max_x;        // the platform must reach this x (m): the run challenged the limits
-  bool p16p_legs = false;  // with config/overlays/p16p.yaml: the prototype's DC-motor legs
+  int lcm_port;                 // this file's private ports: 7820-7829
+  double duration_s;            // simulated seconds
+  double min_max_x;             // the platform must reach this x (m): the run challenged the limits
+  bool p16p_legs = false;       // with config/overlays/p16p.yaml: the prototype's DC-motor legs
+  const char* truth = nullptr;  // config/truths/ file the plant runs (null: the config's own)
 };
 
 // paper: x moves to 0.1 m at the 0.015 m/s velocity limit during 0-10 s, then
@@ -44,11 +45,14 @@ struct StackCase {
 const StackCase kCases[] = {{"paper", 7820, 12.0, 0.09},
                             {"beyond-limits", 7821, 12.0, 0.10},
                             {"paper", 7823, 12.0, 0.08, true},
-                            {"beyond-limits", 7824, 12.0, 0.0835, true}};
+                            {"beyond-limits", 7824, 12.0, 0.0835, true},
+                            // The bounds' heavy corner on motors 5 % off the model.
+                            {"paper", 7825, 12.0, 0.08, true, "bounds-p16p-heavy-corner.yaml"}};
 
 void PrintTo(const StackCase& c, std::ostream* os) {
-  *os << c.scenario << (c.p16p_legs ? " with P-16P legs" : "") << " (" << c.duration_s
-      << " s, LCM port " << c.lcm_port << ")";
+  *os << c.scenario << (c.p16p_legs ? " with P-16P legs" : "")
+      << (c.truth != nullptr ? std::string(" on ") + c.truth : std::string()) << " ("
+      << c.duration_s << " s, LCM port " << c.lcm_port << ")";
 }
 
 class StackLockstep : public WithRunFolder<::testing::TestWithParam<StackCase>> {
@@ -60,11 +64,14 @@ TEST_P(StackLockstep, LimitsHoldOnGroundTruth) {
   const StackCase& c = GetParam();
   const std::string run_dir = run_folder_ + "/run";
   const std::string output_path = run_folder_ + "/launch.out";
-  const LaunchResult launch =
-      RunLauncher("--scenario " + ShellQuote(c.scenario) + " --duration " +
-                      FormatNumber(c.duration_s) + " --no-build --no-report" +
-                      (c.p16p_legs ? " --overlay " + ShellQuote(DcMotorOverlayPath()) : ""),
-                  c.lcm_port, run_dir, output_path);
+  const LaunchResult launch = RunLauncher(
+      "--scenario " + ShellQuote(c.scenario) + " --duration " + FormatNumber(c.duration_s) +
+          " --no-build --no-report" +
+          (c.p16p_legs ? " --overlay " + ShellQuote(DcMotorOverlayPath()) : "") +
+          (c.truth != nullptr ? " --truth " + ShellQuote(std::string(STEWART_SOURCE_DIR) +
+                                                         "/config/truths/" + c.truth)
+                              : ""),
+      c.lcm_port, run_dir, output_path);
   ASSERT_EQ(launch.exit_code, 0) << LaunchFailure(launch);
 
   // The limits the run used: the launcher keeps its config beside the log.
@@ -98,6 +105,10 @@ TEST_P(StackLockstep, LimitsHoldOnGroundTruth) {
 INSTANTIATE_TEST_SUITE_P(Scenarios, StackLockstep, ::testing::ValuesIn(kCases),
                          [](const ::testing::TestParamInfo<StackCase>& param_info) {
                            std::string name = param_info.param.scenario;
+                           if (param_info.param.truth != nullptr) {
+                             const std::string truth = param_info.param.truth;
+                             name = truth.substr(0, truth.find('.')) + "_" + name;
+                           }
                            for (char& ch : name)
                              if (ch == '-') ch = '_';
                            return param_info.param.p16p_legs ? name + "_p16p" : name;
