@@ -280,6 +280,18 @@ PlantTruth ParsePlantTruth(const StackConfig& config, const YAML::Node& config_r
   return t;
 }
 
+std::string TruthLegModelMismatch(const StackConfig& config, const PlantTruth& truth) {
+  if (truth.actuators.kind == config.actuators.kind) return "";
+  const auto name = [](ActuatorKind kind) {
+    return kind == ActuatorKind::kDcMotor ? "dc_motor" : "ideal_force";
+  };
+  return std::string("the plant's legs are ") + name(truth.actuators.kind) + ", the stack's " +
+         name(config.actuators.kind) +
+         ": a truth overrides the config file, not its overlays; if the plant should have the "
+         "stack's legs, set actuators.model: " +
+         name(config.actuators.kind) + " in the truth";
+}
+
 PlantTruth LoadPlantTruth(const StackConfig& config, const std::string& truth_path) {
   if (truth_path.empty()) return TruthOfConfig(config);
   if (config.source_path.empty()) {

@@ -75,6 +75,9 @@ int main(int argc, char** argv) {
         options.mode =
             mode == "lockstep" ? stewart::SimMode::kLockstep : stewart::SimMode::kRealTime;
         truth = stewart::LoadPlantTruth(config, truth_path);
+        if (const std::string m = stewart::TruthLegModelMismatch(config, truth); !m.empty()) {
+          spdlog::warn("plant_sim: {}", m);
+        }
         ToVector6(initial_pose, "--initial-pose", &truth.initial_pose);
         ToVector6(initial_velocity, "--initial-velocity", &truth.initial_velocity);
         return std::nullopt;

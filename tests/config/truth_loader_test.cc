@@ -7,6 +7,7 @@
 #include <string>
 
 #include "stewart/config/config_loader.h"
+#include "stewart/config/default_config.h"
 #include "stewart/model/dynamics.h"
 
 namespace stewart {
@@ -53,6 +54,23 @@ TEST(TruthLoader, TheBoundsCornersLoad) {
   const DcMotorParams& nominal = Config().actuators.motor;
   EXPECT_NEAR(p16p_heavy.actuators.motor.stall_force_n / nominal.stall_force_n, 0.95, 1e-12);
   EXPECT_NEAR(p16p_light.actuators.motor.stall_force_n / nominal.stall_force_n, 1.05, 1e-12);
+}
+
+// A truth that does not name the legs, given with an overlay that does: the
+// plant gets the config file's legs, and the loader says what to set.
+TEST(TruthLoader, SaysWhenThePlantsLegsAreNotTheStacks) {
+  const std::string dir = std::string(STEWART_SOURCE_DIR) + "/config/truths/";
+  const StackConfig p16p = LoadStackConfig(DefaultConfigPath(), {DcMotorOverlayPath()});
+  const PlantTruth ideal_legs = LoadPlantTruth(p16p, dir + "bounds-heavy-corner.yaml");
+  EXPECT_EQ(ideal_legs.actuators.kind, ActuatorKind::kIdealForce);
+  const std::string message = TruthLegModelMismatch(p16p, ideal_legs);
+  EXPECT_NE(message.find("actuators.model: dc_motor"), std::string::npos) << message;
+  EXPECT_EQ(
+      TruthLegModelMismatch(p16p, LoadPlantTruth(p16p, dir + "bounds-p16p-heavy-corner.yaml")), "");
+  EXPECT_EQ(
+      TruthLegModelMismatch(Config(), LoadPlantTruth(Config(), dir + "bounds-heavy-corner.yaml")),
+      "");
+  EXPECT_EQ(TruthLegModelMismatch(p16p, LoadPlantTruth(p16p, "")), "");
 }
 
 TEST(TruthLoader, OverridesKeyByKeyAndKeepsTheRest) {

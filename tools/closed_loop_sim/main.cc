@@ -52,7 +52,12 @@ int main(int argc, char** argv) {
     if (k_velocity) config.safety.k_velocity = *k_velocity;
     if (k_position) config.safety.k_position = *k_position;
     if (!variant.empty()) config.safety.variant = ParseSafetyVariant(variant);
-    if (!truth_path.empty()) options.truth = LoadPlantTruth(config, truth_path);
+    if (!truth_path.empty()) {
+      options.truth = LoadPlantTruth(config, truth_path);
+      if (const std::string m = TruthLegModelMismatch(config, *options.truth); !m.empty()) {
+        spdlog::warn("{}", m);
+      }
+    }
     const Scenario scenario = LoadScenario(ResolveScenarioPath(scenario_name));
     options.duration_s = duration_s.value_or(scenario.duration_s());
     options.share_model_terms = !own_terms;

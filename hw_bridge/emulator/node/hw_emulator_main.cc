@@ -53,6 +53,9 @@ int main(int argc, char** argv) {
         stewart::EmulatorPeriodUs(options.rate_hz);
         options.noise = !no_noise;
         truth = stewart::LoadPlantTruth(config, truth_path);
+        if (const std::string m = stewart::TruthLegModelMismatch(config, truth); !m.empty()) {
+          spdlog::warn("hw_emulator: {}", m);
+        }
         return std::nullopt;
       },
       [&](const stewart::StackConfig& config, lcm::LCM* lcm) {

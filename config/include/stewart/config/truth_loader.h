@@ -24,6 +24,13 @@ namespace stewart {
 /// Throws ConfigError naming the key ("truth.platform.payload.mass_kg").
 PlantTruth LoadPlantTruth(const StackConfig& config, const std::string& truth_path);
 
+/// When the plant's legs are another model than the stack's, what to tell
+/// the user; empty when they agree. The usual cause: a truth that does not
+/// name `actuators.model`, given with an overlay that does (e.g.
+/// config/overlays/p16p.yaml): the truth overrides the file, so the plant
+/// gets the file's legs.
+std::string TruthLegModelMismatch(const StackConfig& config, const PlantTruth& truth);
+
 /// The same from parsed YAML: `config_root` a whole stack config, `truth`
 /// a truth document (a mapping; an empty one gives the config's values).
 PlantTruth ParsePlantTruth(const StackConfig& config, const YAML::Node& config_root,
