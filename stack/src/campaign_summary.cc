@@ -271,6 +271,23 @@ json SummarizeCampaign(const CsvTable& runs, const json& meta, double tolerance)
   s["runs_with_endstop_hits"] = count_positive("endstop_hits");
   s["endstop_hits"] = total("endstop_hits");
   s["runs_with_stiff_fallbacks"] = count_positive("stiff_fallbacks");
+  // The leg-stroke barriers' band (not in "held": the limits the campaign
+  // judges are the configured axis limits).
+  {
+    const std::vector<double> stroke = column_values("leg_stroke_margin_m");
+    long beyond = 0, beyond_tolerance = 0;
+    double worst = 1e9;
+    for (const double m : stroke) {
+      beyond += m < 0.0 ? 1 : 0;
+      beyond_tolerance += -m > tolerance ? 1 : 0;
+      worst = std::min(worst, m);
+    }
+    if (!stroke.empty() && worst < 1e8) {
+      s["leg_stroke_worst_margin_m"] = worst;
+      s["runs_beyond_leg_stroke_margin"] = beyond;
+      s["runs_beyond_leg_stroke_margin_tolerance"] = beyond_tolerance;
+    }
+  }
   const std::vector<double> completed = column_values("completed");
   json failed = json::array();
   const int failure_col = runs.Column("failure");
@@ -381,6 +398,14 @@ std::string SummaryMarkdown(const json& s) {
     << " hits); plant intervals integrated by the stiff "
        "fallback in "
     << s.value("runs_with_stiff_fallbacks", 0L) << " runs\n";
+  if (s.contains("leg_stroke_worst_margin_m")) {
+    o << "- legs beyond the band the leg-stroke barriers keep (the stroke drawn in by its margin; "
+         "not counted in held): "
+      << s["runs_beyond_leg_stroke_margin"].get<long>() << " runs, "
+      << s["runs_beyond_leg_stroke_margin_tolerance"].get<long>()
+      << " by more than the tolerance; worst margin "
+      << Fmt("%.2f", s["leg_stroke_worst_margin_m"].get<double>() * 1e3) << " mm\n";
+  }
   o << "- failed runs: " << s["failed_runs"].size() << "\n";
   for (const json& f : s["failed_runs"]) {
     o << "  - index " << f["index"].get<long>() << ", seed " << f["seed"].get<unsigned long>()

@@ -10,6 +10,7 @@
 #include "stewart/common/signals.h"
 #include "stewart/controller/controller_process.h"
 #include "stewart/estimator/estimator_process.h"
+#include "stewart/model/kinematics.h"
 #include "stewart/model/shared_dynamics_terms.h"
 #include "stewart/plant_sim/disturbance_source.h"
 #include "stewart/plant_sim/ode_integrator.h"
@@ -79,6 +80,10 @@ ClosedLoopSummary RunClosedLoop(const StackConfig& config, const Scenario& scena
   SensorModel sensor_model(truth.sensors, truth.actuators, truth.platform.gravity_mps2,
                            truth.sensor_errors);
   DisturbanceSource disturbance(truth.disturbance, truth.sensors.seed);
+  // The band the leg-stroke barriers keep the legs in (BuildConstraintSet):
+  // the stack's stroke, drawn in by the margin at each end.
+  const double stroke_low_m = config.platform.leg_min_length_m + config.safety.leg_stroke.margin_m;
+  const double stroke_high_m = config.platform.leg_max_length_m - config.safety.leg_stroke.margin_m;
   // The processes' own classes, stepped in the order lockstep runs them:
   // sample -> estimator -> controller -> safety -> plant.
   HealthCounters estimator_counters("estimator"), controller_counters("controller"),
@@ -249,6 +254,14 @@ ClosedLoopSummary RunClosedLoop(const StackConfig& config, const Scenario& scena
     out.qd_max = out.qd_max.cwiseMax(qd1);
     out.qd_min = out.qd_min.cwiseMin(qd1);
     TrackLimitExcess(config.safety, q1, qd1, &out);
+    if (config.safety.leg_stroke.enabled) {
+      const Vector6d leg_length_m = InverseKinematics(truth.platform, q1);
+      const double inside_m = std::min((leg_length_m.array() - stroke_low_m).minCoeff(),
+                                       (stroke_high_m - leg_length_m.array()).minCoeff());
+      if (std::isfinite(inside_m)) {
+        out.leg_stroke_worst_margin_m = std::min(out.leg_stroke_worst_margin_m, inside_m);
+      }
+    }
     ++out.ticks;
     if (!q1.allFinite() || !qd1.allFinite()) {
       out.failure = "non-finite plant state";
@@ -323,6 +336,13 @@ std::string FormatSummary(const StackConfig& config, const ClosedLoopSummary& s)
                 s.rms_tracking_error_inside(1), s.rms_tracking_error_inside(2), s.inside_ticks[0],
                 s.inside_ticks[1], s.inside_ticks[2]);
   o << line;
+  if (s.leg_stroke_worst_margin_m < 1e8) {
+    std::snprintf(line, sizeof line,
+                  "legs: closest %.2f mm inside the leg-stroke barriers' band (negative: beyond "
+                  "it); end-stop hits %ld\n",
+                  s.leg_stroke_worst_margin_m * 1e3, s.endstop_hits);
+    o << line;
+  }
   return o.str();
 }
 

@@ -72,8 +72,13 @@ struct ClosedLoopSummary {
   /// Ticks the un-composed QP answered because the composed answer broke a
   /// barrier's own condition (FLAG_PER_BARRIER).
   long per_barrier_ticks = 0;
-  long fallback_ticks = 0;        ///< ticks the safety process answered with its fallback
-  long endstop_hits = 0;          ///< legs entering an end-stop (plant)
+  long fallback_ticks = 0;  ///< ticks the safety process answered with its fallback
+  long endstop_hits = 0;    ///< legs entering an end-stop (plant)
+  /// The plant's legs against the stroke the filter's leg-stroke barriers
+  /// keep them in (the config's stroke drawn in by safety.leg_stroke.margin_m
+  /// at each end): the smallest distance inside it over the run (m),
+  /// negative when a leg went beyond it. 1e9 without leg-stroke barriers.
+  double leg_stroke_worst_margin_m = 1e9;
   long stiff_fallbacks = 0;       ///< plant intervals the BDF fallback integrated (Plant)
   long estimator_rejections = 0;  ///< sensor samples or updates the estimator rejected
   long saturated_ticks = 0;       ///< ticks where |F*_i| exceeded the actuator force limit
