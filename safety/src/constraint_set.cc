@@ -45,6 +45,10 @@ Vector6d JointToleranceMargin(const PlatformParams& platform, const SafetyConfig
   return margin;
 }
 
+LegStrokeBand LegStrokeBandOf(const PlatformParams& platform, const LegStrokeLimitConfig& stroke) {
+  return {platform.leg_min_length_m + stroke.margin_m, platform.leg_max_length_m - stroke.margin_m};
+}
+
 ConstraintSet BuildConstraintSet(const PlatformParams& platform, const SafetyConfig& safety) {
   ConstraintSet c;
   STEWART_CHECK_INPUT(safety.k_position > 0.0, "safety.k_position", "must be positive");
@@ -93,13 +97,15 @@ ConstraintSet BuildConstraintSet(const PlatformParams& platform, const SafetyCon
   }
   if (safety.leg_stroke.enabled) {
     const LegStrokeLimitConfig& s = safety.leg_stroke;
-    const double lower = platform.leg_min_length_m + s.margin_m;
-    const double upper = platform.leg_max_length_m - s.margin_m;
-    STEWART_CHECK_INPUT(lower < upper, "safety.leg_stroke.margin_m", "leaves no stroke");
+    const LegStrokeBand band = LegStrokeBandOf(platform, s);
+    STEWART_CHECK_INPUT(band.lower_m < band.upper_m, "safety.leg_stroke.margin_m",
+                        "leaves no stroke");
     for (int i = 0; i < kNumLegs; ++i) {
       const std::string leg = "leg" + std::to_string(i);
-      add_position(PositionSource::kLegLength, i, 1.0, lower, s.alpha_e, s.alpha, leg + "_lower");
-      add_position(PositionSource::kLegLength, i, -1.0, upper, s.alpha_e, s.alpha, leg + "_upper");
+      add_position(PositionSource::kLegLength, i, 1.0, band.lower_m, s.alpha_e, s.alpha,
+                   leg + "_lower");
+      add_position(PositionSource::kLegLength, i, -1.0, band.upper_m, s.alpha_e, s.alpha,
+                   leg + "_upper");
     }
   }
   auto add_velocity = [&](int axis, double sign, double limit, double alpha_v,

@@ -10,12 +10,12 @@
 #include "stewart/common/signals.h"
 #include "stewart/controller/controller_process.h"
 #include "stewart/estimator/estimator_process.h"
-#include "stewart/model/kinematics.h"
 #include "stewart/model/shared_dynamics_terms.h"
 #include "stewart/plant_sim/disturbance_source.h"
 #include "stewart/plant_sim/ode_integrator.h"
 #include "stewart/plant_sim/plant.h"
 #include "stewart/plant_sim/sensor_model.h"
+#include "stewart/safety/constraint_set.h"
 #include "stewart/safety/safety_process.h"
 
 namespace stewart {
@@ -80,10 +80,8 @@ ClosedLoopSummary RunClosedLoop(const StackConfig& config, const Scenario& scena
   SensorModel sensor_model(truth.sensors, truth.actuators, truth.platform.gravity_mps2,
                            truth.sensor_errors);
   DisturbanceSource disturbance(truth.disturbance, truth.sensors.seed);
-  // The band the leg-stroke barriers keep the legs in (BuildConstraintSet):
-  // the stack's stroke, drawn in by the margin at each end.
-  const double stroke_low_m = config.platform.leg_min_length_m + config.safety.leg_stroke.margin_m;
-  const double stroke_high_m = config.platform.leg_max_length_m - config.safety.leg_stroke.margin_m;
+  const safety::LegStrokeBand stroke_band =
+      safety::LegStrokeBandOf(config.platform, config.safety.leg_stroke);
   // The processes' own classes, stepped in the order lockstep runs them:
   // sample -> estimator -> controller -> safety -> plant.
   HealthCounters estimator_counters("estimator"), controller_counters("controller"),
@@ -146,6 +144,15 @@ ClosedLoopSummary RunClosedLoop(const StackConfig& config, const Scenario& scena
     const PlantRates& rates = plant.EvaluateRates();
     const SensorReading r =
         sensor_model.Sample(q_true, qd_true, rates.x_dot.segment<6>(6), rates.terms.leg_length_m);
+    if (config.safety.leg_stroke.enabled) {
+      // The plant's own leg lengths at this state (its model terms).
+      const Vector6d& leg_length_m = rates.terms.leg_length_m;
+      const double inside_m = std::min((leg_length_m.array() - stroke_band.lower_m).minCoeff(),
+                                       (stroke_band.upper_m - leg_length_m.array()).minCoeff());
+      if (std::isfinite(inside_m)) {
+        out.leg_stroke_worst_margin_m = std::min(out.leg_stroke_worst_margin_m, inside_m);
+      }
+    }
     StateSample state;
     bool has_state = false;
     if (options.perfect_state) {
@@ -254,14 +261,6 @@ ClosedLoopSummary RunClosedLoop(const StackConfig& config, const Scenario& scena
     out.qd_max = out.qd_max.cwiseMax(qd1);
     out.qd_min = out.qd_min.cwiseMin(qd1);
     TrackLimitExcess(config.safety, q1, qd1, &out);
-    if (config.safety.leg_stroke.enabled) {
-      const Vector6d leg_length_m = InverseKinematics(truth.platform, q1);
-      const double inside_m = std::min((leg_length_m.array() - stroke_low_m).minCoeff(),
-                                       (stroke_high_m - leg_length_m.array()).minCoeff());
-      if (std::isfinite(inside_m)) {
-        out.leg_stroke_worst_margin_m = std::min(out.leg_stroke_worst_margin_m, inside_m);
-      }
-    }
     ++out.ticks;
     if (!q1.allFinite() || !qd1.allFinite()) {
       out.failure = "non-finite plant state";

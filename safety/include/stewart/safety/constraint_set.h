@@ -104,4 +104,13 @@ Vector6d JointToleranceMargin(const PlatformParams& platform, const SafetyConfig
 /// non-positive gains.
 ConstraintSet BuildConstraintSet(const PlatformParams& platform, const SafetyConfig& safety);
 
+/// The band the leg-stroke barriers keep each leg length in (m): the
+/// stroke [leg_min_length_m, leg_max_length_m] drawn in by
+/// safety.leg_stroke.margin_m at each end.
+struct LegStrokeBand {
+  double lower_m = 0.0;
+  double upper_m = 0.0;
+};
+LegStrokeBand LegStrokeBandOf(const PlatformParams& platform, const LegStrokeLimitConfig& stroke);
+
 }  // namespace stewart::safety
