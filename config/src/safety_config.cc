@@ -57,6 +57,7 @@ SafetyConfig ParseSafetyConfig(const ConfigNode& safety) {
   s.leg_stroke.margin_m = leg.NonNegativeDouble("margin_m");
   s.leg_stroke.alpha_e = leg.PositiveDouble("alpha_e");
   s.leg_stroke.alpha = leg.PositiveDouble("alpha");
+  if (leg.Has("recovery")) s.leg_stroke.recovery = leg.Bool("recovery");
   s.force_limits_enabled = safety.Bool("force_limits_enabled");
   s.stale_age_s = safety.PositiveDouble("stale_age_s");
   s.fallback = safety.EnumValue("fallback", kSafetyFallbackNames);

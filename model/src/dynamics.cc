@@ -28,10 +28,11 @@ using internal::SumOfOuterProducts;
 // and joint-space bias and gravity forces (N), mapped through J_a^T
 // (docs/model.md, "Dynamics"). A is rank one in n, so no 3x3 product is needed.
 struct LegJointTerms {
-  LegScalars c;       // isotropic part of A (kg)
-  LegScalars d;       // n n^T part of A (kg)
-  LegVectors f_bias;  // joint-space bias force (N)
-  LegVectors f_grav;  // joint-space gravity force (N)
+  LegScalars c;               // isotropic part of A (kg)
+  LegScalars d;               // n n^T part of A (kg)
+  LegVectors f_bias;          // joint-space bias force (N)
+  LegVectors f_grav;          // joint-space gravity force (N)
+  LegScalars leg_bias_accel;  // Ldd at qdd = 0: n . a_bias + L |nd|^2 (m/s^2)
 };
 
 // The leg's mass constants, the same for every leg.
@@ -70,8 +71,9 @@ LegJointTerms ComputeLegJointTerms(const LegMassConstants& k, double g, const Le
   // Lagrangian term is m_r Ldd J_l^T: the velocity terms cancel), whose first
   // part is in A a_bias.
   const LegScalars nd_sq = nd.square().colwise().sum();
-  const LegScalars along_n =
-      out.d * Dot(n, a_bias) + (k.m2 * k.e2 + k.m_r / inv_l) * nd_sq;
+  const LegScalars along_n = out.d * Dot(n, a_bias) + (k.m2 * k.e2 + k.m_r / inv_l) * nd_sq;
+  // Apart from along_n, whose expression (and so its rounding) stays as it was.
+  out.leg_bias_accel = Dot(n, a_bias) + nd_sq / inv_l;
   const LegScalars along_nd = 2.0 * ld * inv_l * (k.m2 * k.e2 * s - k.mu * inv_l);
   out.f_bias = a_bias.rowwise() * out.c + n.rowwise() * along_n + nd.rowwise() * along_nd;
   // V = g (m1 e1 n_z + m2 (a - e2 n)_z):
@@ -118,6 +120,7 @@ void EvaluateDynamics(const PlatformParams& params, const Vector6d& q, const Vec
   const LegJointTerms legs =
       ComputeLegJointTerms(LegMassConstants(params.leg), g, n, inv_l, v, a_bias);
   terms->leg_length_m = geometry.length.transpose();
+  terms->leg_bias_accel_mps2 = legs.leg_bias_accel.transpose();
   terms->H.topRows<3>() = n.matrix();
   terms->H.bottomRows<3>().noalias() = E.transpose() * u.matrix();
 

@@ -67,7 +67,10 @@ void EvaluatePreparedBarriers(const ConstraintSet& c, const Vector6d& q, const V
       const double h = s.sign * (value - s.limit);
       if (h < 0.0) {
         e.outside_safe_set = true;
-        e.outside_position_set = e.outside_position_set || (axis && c.has_recovery);
+        // Its recovery barrier steers back (axis limits have one whenever
+        // any exist, the legs' strokes when has_leg_recovery).
+        e.outside_position_set =
+            e.outside_position_set || (axis ? c.has_recovery : c.has_leg_recovery);
       }
       e.h_position[k] = -kinetic + s.alpha_e * h;
       e.alpha_h_position[k] = s.alpha * e.h_position[k];
@@ -102,27 +105,64 @@ void EvaluatePreparedBarriers(const ConstraintSet& c, const Vector6d& q, const V
       x->m_inv_a_c.setConstant(NAN);
       return;
     }
+    // r_i = a_i^T qd / sign_i: qd_j for an axis, ld_i for a leg.
+    auto rate_of = [&](const VelocityBarrierSpec& s) {
+      return s.source == PositionSource::kAxis ? qd(s.index) : x->leg_rate(s.index);
+    };
+    // The active barriers' alpha h, packed for the composition.
+    std::array<double, kMaxVelocityBarriers> packed_alpha_h;
+    std::array<double, kMaxVelocityBarriers> packed_w;
+    int num_active = 0;
     for (int i = 0; i < c.num_velocity; ++i) {
       const size_t k = static_cast<size_t>(i);
       const VelocityBarrierSpec& s = c.velocity[k];
+      e.velocity_active[k] = true;
       if (s.recovery_of < 0) {
-        e.h_velocity[k] = s.sign * (qd(s.axis) - s.limit);
+        e.h_velocity[k] = s.sign * (rate_of(s) - s.limit);
         if (e.h_velocity[k] < 0.0) e.outside_safe_set = true;
       } else {
         const PositionBarrierSpec& p = c.position[static_cast<size_t>(s.recovery_of)];
+        const double value =
+            p.source == PositionSource::kAxis ? q(p.index) : terms.leg_length_m(p.index);
         double phi = 0.0, dphi_dh = 0.0;
-        RecoveryTarget(s, p.sign * (q(p.index) - p.limit), &phi, &dphi_dh);
-        e.h_velocity[k] = s.sign * qd(s.axis) + phi;
+        const double h_position = p.sign * (value - p.limit);
+        RecoveryTarget(s, h_position, &phi, &dphi_dh);
+        e.h_velocity[k] = s.sign * rate_of(s) + phi;
         recovery_slope[k] = dphi_dh;
+        // Inside its band a leg's energy barrier guards it; its recovery
+        // barrier would only add a second, far more conservative condition
+        // (the worst case over d maps a torque's uncertainty through the
+        // leg's lever arm: tens of m/s^2 on the light platform).
+        e.velocity_active[k] = s.source == PositionSource::kAxis || h_position < 0.0;
       }
       e.alpha_h_velocity[k] = s.alpha_v * e.h_velocity[k];
+      if (e.velocity_active[k]) {
+        packed_alpha_h[static_cast<size_t>(num_active++)] = e.alpha_h_velocity[k];
+      }
     }
-    e.h_vel = ComposeLogSumExp(e.alpha_h_velocity.data(), c.num_velocity, c.k_velocity,
-                               e.w_velocity.data());
+    if (num_active == 0) {
+      // Only legs' recovery barriers, every leg inside its band: no group.
+      e.w_velocity.fill(0.0);
+      e.h_vel = e.psi_v = 0.0;
+      x->m_inv_a_c.setZero();
+      e.g_v.setZero();
+      return;
+    }
+    e.h_vel = ComposeLogSumExp(packed_alpha_h.data(), num_active, c.k_velocity, packed_w.data());
+    for (int i = 0, j = 0; i < c.num_velocity; ++i) {
+      const size_t k = static_cast<size_t>(i);
+      e.w_velocity[k] = e.velocity_active[k] ? packed_w[static_cast<size_t>(j++)] : 0.0;
+    }
     for (int i = 0; i < c.num_velocity; ++i) {
       const size_t k = static_cast<size_t>(i);
       const VelocityBarrierSpec& s = c.velocity[k];
-      x->a_c(s.axis) += s.alpha_v * e.w_velocity[k] * s.sign;
+      if (!e.velocity_active[k]) continue;
+      const double weight = s.alpha_v * e.w_velocity[k] * s.sign;
+      if (s.source == PositionSource::kAxis) {
+        x->a_c(s.index) += weight;
+      } else {
+        x->a_c += weight * terms.H.col(s.index);
+      }
     }
     // qdd_des = M^-1 (H F_des + d^ - C qd - G), M^-1 a_c and M^-1 in one pass.
     Rhs6<8> rhs;
@@ -131,15 +171,32 @@ void EvaluatePreparedBarriers(const ConstraintSet& c, const Vector6d& q, const V
     rhs.rightCols<6>().setIdentity();
     x->inertia.SolveInPlace<8>(&rhs);
     x->m_inv = rhs.rightCols<6>();
-    // dh_v,i/dd = sign_i (M^-1)_(axis, :): the worst case per axis.
+    // dh_v,i/dd = a_i^T M^-1: the worst case per axis, sum_j |(M^-1)_(axis, j)|
+    // sigma_j; a leg's row is H(:, i)^T M^-1, its worst case computed apart.
     Vector6d axis_bound = Vector6d::Zero();
     if (robust) axis_bound.noalias() = x->m_inv.cwiseAbs() * d_bound;
     double psi = c.velocity_rate_per_s * e.h_vel;
     for (int i = 0; i < c.num_velocity; ++i) {
       const size_t k = static_cast<size_t>(i);
       const VelocityBarrierSpec& s = c.velocity[k];
-      e.dh_velocity[k] = s.sign * rhs(s.axis, 0) - axis_bound(s.axis);
-      if (s.recovery_of >= 0) e.dh_velocity[k] += recovery_slope[k] * s.sign * qd(s.axis);
+      if (!e.velocity_active[k]) {
+        e.dh_velocity[k] = 0.0;
+        continue;
+      }
+      if (s.source == PositionSource::kAxis) {
+        e.dh_velocity[k] = s.sign * rhs(s.index, 0) - axis_bound(s.index);
+      } else {
+        // Ldd_i = H(:, i)^T qdd + (J_l-dot qd)_i.
+        const auto column = terms.H.col(s.index);
+        const double leg_accel = column.dot(rhs.col(0)) + terms.leg_bias_accel_mps2(s.index);
+        // d^ but not its worst case: through the leg's lever arm a torque's
+        // uncertainty is tens of m/s^2 of leg acceleration on the light
+        // platform, and asking for that outward would leave no zdd within
+        // zd's limit (every leg beyond its band infeasible). The recovery
+        // barrier steers back; the energy barrier is the leg's invariance.
+        e.dh_velocity[k] = s.sign * leg_accel;
+      }
+      if (s.recovery_of >= 0) e.dh_velocity[k] += recovery_slope[k] * s.sign * rate_of(s);
       psi += s.alpha_v * e.w_velocity[k] * e.dh_velocity[k];
     }
     e.psi_v = psi - c.velocity_margin;

@@ -108,14 +108,15 @@ ConstraintSet BuildConstraintSet(const PlatformParams& platform, const SafetyCon
                    leg + "_upper");
     }
   }
-  auto add_velocity = [&](int axis, double sign, double limit, double alpha_v,
-                          const std::string& name) {
+  auto add_velocity = [&](PositionSource source, int index, double sign, double limit,
+                          double alpha_v, const std::string& name) {
     STEWART_CHECK_INPUT(c.num_velocity < kMaxVelocityBarriers, "safety.velocity_limits",
                         "too many velocity limits (axis listed twice?)");
     STEWART_CHECK_INPUT(alpha_v > 0.0, "safety constraint " + name, "alpha_v must be positive");
     VelocityBarrierSpec& v = c.velocity[static_cast<size_t>(c.num_velocity++)];
     v = VelocityBarrierSpec{};
-    v.axis = axis;
+    v.source = source;
+    v.index = index;
     v.sign = sign;
     v.limit = limit;
     v.alpha_v = alpha_v;
@@ -123,8 +124,10 @@ ConstraintSet BuildConstraintSet(const PlatformParams& platform, const SafetyCon
   };
   for (const VelocityLimitConfig& l : safety.velocity_limits) {
     const std::string axis = std::string(kAxisNames[static_cast<size_t>(l.axis)]) + "d";
-    if (l.lower) add_velocity(l.axis, 1.0, *l.lower, l.alpha_v, axis + "_lower");
-    if (l.upper) add_velocity(l.axis, -1.0, *l.upper, l.alpha_v, axis + "_upper");
+    if (l.lower)
+      add_velocity(PositionSource::kAxis, l.axis, 1.0, *l.lower, l.alpha_v, axis + "_lower");
+    if (l.upper)
+      add_velocity(PositionSource::kAxis, l.axis, -1.0, *l.upper, l.alpha_v, axis + "_upper");
   }
   // Recovery barriers: relative degree one in F (unlike the energy barrier,
   // whose F gradient -H^T qd vanishes at rest), so the set stays attractive
@@ -132,28 +135,35 @@ ConstraintSet BuildConstraintSet(const PlatformParams& platform, const SafetyCon
   // then obeys h'' + 2 kappa h' + kappa^2 h >= 0 (critically damped).
   const double kappa = safety.recovery_gain_per_s;
   STEWART_CHECK_INPUT(kappa >= 0.0, "safety.recovery_gain_per_s", "must be >= 0");
+  // The speed back stays within the velocity limits (else the recovery and
+  // velocity barriers would leave no feasible velocity): half the smallest
+  // limit of the axis, and for a leg, which moves with every axis, of any
+  // translational axis.
+  auto slowest_limit = [&](auto on_axis) {
+    double slowest = 0.0;
+    for (const VelocityLimitConfig& l : safety.velocity_limits) {
+      if (!on_axis(l.axis)) continue;
+      for (const std::optional<double>& v : {l.lower, l.upper}) {
+        if (v && (slowest == 0.0 || std::fabs(*v) < slowest)) slowest = std::fabs(*v);
+      }
+    }
+    return slowest;
+  };
   if (kappa > 0.0) {
     const int num_position = c.num_position;
     for (int i = 0; i < num_position; ++i) {
       const PositionBarrierSpec& p = c.position[static_cast<size_t>(i)];
-      if (p.source != PositionSource::kAxis) continue;
-      // The speed back stays within the axis's velocity limits (else the
-      // recovery and velocity barriers would leave no feasible velocity).
-      double slowest_limit = 0.0;
-      for (const VelocityLimitConfig& l : safety.velocity_limits) {
-        if (l.axis != p.index) continue;
-        for (const std::optional<double>& v : {l.lower, l.upper}) {
-          if (v && (slowest_limit == 0.0 || std::fabs(*v) < slowest_limit)) {
-            slowest_limit = std::fabs(*v);
-          }
-        }
-      }
-      add_velocity(p.index, p.sign, 0.0, kappa, p.name + "_recovery");
+      const bool axis = p.source == PositionSource::kAxis;
+      if (!axis && !safety.leg_stroke.recovery) continue;
+      const double slowest = axis ? slowest_limit([&](int a) { return a == p.index; })
+                                  : slowest_limit([](int a) { return a < 3; });
+      add_velocity(p.source, p.index, p.sign, 0.0, kappa, p.name + "_recovery");
       VelocityBarrierSpec& r = c.velocity[static_cast<size_t>(c.num_velocity - 1)];
       r.recovery_of = i;
       r.recovery_gain_per_s = kappa;
-      r.recovery_speed = 0.5 * slowest_limit;
+      r.recovery_speed = 0.5 * slowest;
       c.has_recovery = true;
+      c.has_leg_recovery = c.has_leg_recovery || !axis;
     }
   }
   STEWART_CHECK_INPUT(safety.disturbance_sigma >= 0.0, "safety.disturbance_sigma", "must be >= 0");

@@ -341,7 +341,7 @@ double SafetyFilter::DriveOnShift(const DynamicsTerms& terms, const Vector6d& qd
   int sides = 0;
   for (int i = 0; i < constraints_.num_velocity; ++i) {
     const VelocityBarrierSpec& s = constraints_.velocity[static_cast<size_t>(i)];
-    if (s.axis != kZ || s.recovery_of >= 0) continue;
+    if (s.source != PositionSource::kAxis || s.index != kZ || s.recovery_of >= 0) continue;
     limit = &s;
     ++sides;
   }
@@ -446,8 +446,12 @@ bool SafetyFilter::BreaksABarrierCondition(const StepInput& in, const FilterWork
     ws.barrier.inertia.SolveInPlace<1>(&dqdd);
     for (int i = 0; i < c.num_velocity; ++i) {
       const VelocityBarrierSpec& spec = c.velocity[static_cast<size_t>(i)];
+      if (!b.velocity_active[static_cast<size_t>(i)]) continue;
       const double at_nominal = OwnVelocityCondition(c, b, i);
-      const double change = spec.alpha_v * spec.sign * dqdd(spec.axis);
+      const double change =
+          spec.alpha_v * spec.sign *
+          (spec.source == PositionSource::kAxis ? dqdd(spec.index)
+                                                : in.terms.H.col(spec.index).dot(dqdd));
       const double tolerance =
           kPerBarrierRelTol * (std::fabs(at_nominal) + std::fabs(change) + c.velocity_margin);
       if (at_nominal + change < -tolerance) return true;

@@ -120,9 +120,9 @@ bool SafetyFilter::PoseUncomposedQp(const StepInput& in, ConditionGroups groups,
     }
   }
   if (c.num_velocity > 0 && groups != ConditionGroups::kPositionOnly) {
-    // dh_v,i/dF = H^T M^-1 a_i with a_i = sign_i e_axis, mapped to y by T^T:
-    // column `axis` of H^T M^-1 for the force metric, of L_M^-1 for the
-    // acceleration metric.
+    // dh_v,i/dF = H^T M^-1 a_i with a_i = sign_i e_axis (or sign_i H(:, leg)),
+    // mapped to y by T^T: (H^T M^-1) a_i for the force metric, L_M^-1 a_i for
+    // the acceleration metric.
     Matrix6d g;
     if (force_metric) {
       Rhs6<6> m_inv = Rhs6<6>::Identity();
@@ -144,8 +144,15 @@ bool SafetyFilter::PoseUncomposedQp(const StepInput& in, ConditionGroups groups,
     for (int i = 0; i < c.num_velocity; ++i) {
       const size_t k = static_cast<size_t>(i);
       const VelocityBarrierSpec& s = c.velocity[k];
+      if (!b.velocity_active[k]) {
+        rows.velocity_row[k] = -1;
+        continue;
+      }
       const double psi = OwnVelocityCondition(c, b, i);
-      const ConditionRow r = AppendConditionRow(psi, (s.alpha_v * s.sign) * g.col(s.axis), &qp);
+      const Vector6d normal = s.source == PositionSource::kAxis
+                                  ? Vector6d((s.alpha_v * s.sign) * g.col(s.index))
+                                  : Vector6d((s.alpha_v * s.sign) * (g * terms.H.col(s.index)));
+      const ConditionRow r = AppendConditionRow(psi, normal, &qp);
       posable = posable && r.posable;
       rows.velocity_row[k] = r.row;
       rows.velocity_norm[k] = r.norm;

@@ -11,6 +11,8 @@
 
 #include "stewart/config/default_config.h"
 #include "stewart/controller/scenario.h"
+#include "stewart/model/kinematics.h"
+#include "stewart/safety/constraint_set.h"
 #include "stewart/stack/closed_loop.h"
 
 namespace stewart {
@@ -44,6 +46,64 @@ TEST(LegStrokeBand, TheBarriersKeepTheLegsInTheBandTheRunMeasures) {
   ASSERT_TRUE(filtered.completed) << filtered.failure;
   EXPECT_GE(filtered.leg_stroke_worst_margin_m, 0.0);
   EXPECT_LT(filtered.leg_stroke_worst_margin_m, 1e-3);  // stopped at the band, not before
+}
+
+// Held at the band (the setpoint 36 mm below home lies beyond it), the
+// platform is pushed down by 15 N for 0.3 s, which takes the legs beyond the
+// band (2.5 mm). The legs' recovery barriers bring them back to it (0.04 mm
+// beyond at the end); without them (the energy barrier cannot act at rest
+// outside) the legs stay beyond (0.76 mm).
+struct AfterAPush {
+  ClosedLoopSummary summary;
+  double final_margin_m = 0.0;  ///< closest leg to the band at the end (m)
+};
+
+AfterAPush PushBeyondTheBand(bool leg_recovery) {
+  StackConfig config = DefaultStackConfig();
+  config.safety.leg_stroke.recovery = leg_recovery;
+  ScenarioSegment down;
+  down.type = SegmentType::kStep;
+  down.start_s = 0.0;
+  down.end_s = 10.0;
+  down.q_des = config.home_pose;
+  down.q_des(2) -= 0.036;
+  const Scenario scenario("pushed-beyond-the-leg-stroke-band", 10.0, {down});
+  ClosedLoopOptions options;
+  options.duration_s = 10.0;
+  PlantTruth truth = TruthOfConfig(config);
+  WrenchPulse push;
+  push.start_s = 5.0;
+  push.duration_s = 0.3;
+  push.wrench(2) = -15.0;
+  truth.disturbance.pulses.push_back(push);
+  options.truth = truth;
+  AfterAPush out;
+  out.summary = RunClosedLoop(config, scenario, options, nullptr);
+  const safety::LegStrokeBand band =
+      safety::LegStrokeBandOf(config.platform, config.safety.leg_stroke);
+  const Vector6d legs = InverseKinematics(config.platform, out.summary.q_final);
+  out.final_margin_m =
+      std::min((legs.array() - band.lower_m).minCoeff(), (band.upper_m - legs.array()).minCoeff());
+  std::printf(
+      "[leg stroke band] pushed beyond, leg recovery %s: worst %.2f mm, at the end %.2f mm; "
+      "infeasible %ld ticks, end-stop hits %ld, largest excess %.2f mm(/s)\n",
+      leg_recovery ? "on" : "off", out.summary.leg_stroke_worst_margin_m * 1e3,
+      out.final_margin_m * 1e3, out.summary.infeasible_ticks, out.summary.endstop_hits,
+      out.summary.max_limit_excess * 1e3);
+  return out;
+}
+
+TEST(LegStrokeBand, ALegPushedBeyondTheBandIsSteeredBack) {
+  const AfterAPush without = PushBeyondTheBand(false);
+  ASSERT_TRUE(without.summary.completed) << without.summary.failure;
+  EXPECT_LT(without.summary.leg_stroke_worst_margin_m, -1e-3);  // the push took it beyond
+  EXPECT_LT(without.final_margin_m, -5e-4);                     // and stayed beyond
+  const AfterAPush with = PushBeyondTheBand(true);
+  ASSERT_TRUE(with.summary.completed) << with.summary.failure;
+  EXPECT_LT(with.summary.leg_stroke_worst_margin_m, -1e-3);  // pushed beyond too
+  EXPECT_EQ(with.summary.endstop_hits, 0);
+  EXPECT_GE(with.final_margin_m, -2e-4);  // back at the band
+  EXPECT_LT(with.final_margin_m, 1e-3);   // and no further: the setpoint is beyond it
 }
 
 }  // namespace

@@ -37,6 +37,23 @@ TEST(Dynamics, HIsTransposedLegJacobian) {
   });
 }
 
+// Ldd = J_l qdd + J_l-dot qd: with qdd = 0 along q(t) = q + t qd (so the Euler
+// rates stay qd), the legs' acceleration is the derivative of J_l(q(t)) qd,
+// here a central difference.
+TEST(Dynamics, LegBiasAccelerationIsTheLegJacobiansRate) {
+  const auto& p = DefaultConfig().platform;
+  ForRandomPoses(12, kStates, [&](const Vector6d& q, std::mt19937* rng) {
+    const Vector6d qd = RandomVelocity(rng);
+    const DynamicsTerms t = EvaluateDynamics(p, q, qd);
+    constexpr double kStep = 1e-5;
+    const Vector6d ahead = LegLengthJacobian(p, q + kStep * qd) * qd;
+    const Vector6d behind = LegLengthJacobian(p, q - kStep * qd) * qd;
+    const Vector6d expected = (ahead - behind) / (2.0 * kStep);
+    EXPECT_LT((t.leg_bias_accel_mps2 - expected).cwiseAbs().maxCoeff(),
+              1e-7 * (1.0 + expected.cwiseAbs().maxCoeff()));
+  });
+}
+
 // Bit for bit: plant_sim's root functions take the leg lengths of the last
 // model evaluation in place of InverseKinematics at the same q.
 TEST(Dynamics, LegLengthsAreExactlyInverseKinematics) {

@@ -6,6 +6,7 @@
 
 #include "safety_test_support.h"
 #include "stewart/model/joint_tolerance.h"
+#include "stewart/model/kinematics.h"
 
 namespace stewart::safety::test {
 namespace {
@@ -15,17 +16,52 @@ TEST(ConstraintSet, DefaultConfigIsThePapersUpperLimitsAndTheLegStrokes) {
   // x, y, z upper, then a lower and an upper stroke barrier per leg.
   EXPECT_EQ(c.num_position, 3 + 2 * kNumLegs);
   EXPECT_EQ(c.position[3].source, PositionSource::kLegLength);
-  // The three velocity limits, then one recovery barrier per position limit.
-  EXPECT_EQ(c.num_velocity, 6);
+  // The three velocity limits, then one recovery barrier per position limit
+  // (the axes', then the legs').
+  EXPECT_EQ(c.num_velocity, 6 + 2 * kNumLegs);
   EXPECT_EQ(c.position[2].name, "z_upper");
   EXPECT_EQ(c.velocity[2].name, "zd_upper");
   EXPECT_EQ(c.velocity[2].alpha_v, 2.0);
   EXPECT_EQ(c.velocity[2].recovery_of, -1);
   EXPECT_EQ(c.velocity[5].name, "z_upper_recovery");
   EXPECT_EQ(c.velocity[5].recovery_of, 2);
-  EXPECT_EQ(c.velocity[5].axis, 2);
+  EXPECT_EQ(c.velocity[5].index, 2);
   EXPECT_EQ(c.velocity[5].sign, -1.0);
+  EXPECT_EQ(c.velocity[5].source, PositionSource::kAxis);
   EXPECT_TRUE(c.has_recovery);
+  // Leg 0's lower stroke barrier (position 3) and its recovery barrier: the
+  // speed back is half the slowest translational limit (zd's 0.010 m/s).
+  EXPECT_EQ(c.velocity[6].name, "leg0_lower_recovery");
+  EXPECT_EQ(c.velocity[6].source, PositionSource::kLegLength);
+  EXPECT_EQ(c.velocity[6].index, 0);
+  EXPECT_EQ(c.velocity[6].recovery_of, 3);
+  EXPECT_EQ(c.velocity[6].sign, 1.0);
+  EXPECT_DOUBLE_EQ(c.velocity[6].recovery_speed, 0.005);
+  EXPECT_EQ(c.velocity[17].name, "leg5_upper_recovery");
+  EXPECT_TRUE(c.has_leg_recovery);
+}
+
+TEST(ConstraintSet, TheLegsRecoveryCanBeLeftOut) {
+  SafetyConfig s = DefaultConfig().safety;
+  s.leg_stroke.recovery = false;
+  const ConstraintSet c = BuildConstraintSet(DefaultConfig().platform, s);
+  EXPECT_EQ(c.num_velocity, 6);
+  EXPECT_TRUE(c.has_recovery);
+  EXPECT_FALSE(c.has_leg_recovery);
+}
+
+// a_i = dh_v,i/dqd: sign e_j for an axis, sign J_l(i,:)^T for a leg.
+TEST(ConstraintSet, AVelocityBarriersGradientIsItsRatesGradient) {
+  const StackConfig& config = DefaultConfig();
+  const ConstraintSet c = BuildConstraintSet(config.platform, config.safety);
+  Vector6d q = config.home_pose;
+  q(0) += 0.02;
+  q(4) += 0.05;
+  const Matrix6d j_l = LegLengthJacobian(config.platform, q);
+  const Matrix6d h = j_l.transpose();
+  EXPECT_EQ(VelocityBarrierGradient(c.velocity[5], h), -Vector6d::Unit(2));
+  EXPECT_EQ(VelocityBarrierGradient(c.velocity[6], h), Vector6d(j_l.row(0).transpose()));
+  EXPECT_EQ(VelocityBarrierGradient(c.velocity[17], h), Vector6d(-j_l.row(5).transpose()));
 }
 
 TEST(ConstraintSet, RecoveryGainZeroLeavesTheRecoveryBarriersOut) {
@@ -34,13 +70,14 @@ TEST(ConstraintSet, RecoveryGainZeroLeavesTheRecoveryBarriersOut) {
   const ConstraintSet c = BuildConstraintSet(DefaultConfig().platform, s);
   EXPECT_EQ(c.num_velocity, 3);
   EXPECT_FALSE(c.has_recovery);
+  EXPECT_FALSE(c.has_leg_recovery);
 }
 
 TEST(ConstraintSet, RichConfigHasEveryKind) {
   const ConstraintSet c = BuildConstraintSet(DefaultConfig().platform, RichSafetyConfig());
   EXPECT_EQ(c.num_position, 8 + 12);
-  // 8 velocity limits and a recovery barrier per axis limit (not the legs').
-  EXPECT_EQ(c.num_velocity, 8 + 8);
+  // 8 velocity limits and a recovery barrier per axis limit and per leg limit.
+  EXPECT_EQ(c.num_velocity, 8 + 8 + 12);
   EXPECT_EQ(c.position[0].name, "x_lower");
   EXPECT_EQ(c.position[8].name, "leg0_lower");
   EXPECT_EQ(c.position[8].source, PositionSource::kLegLength);

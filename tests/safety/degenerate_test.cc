@@ -2,11 +2,13 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <random>
 #include <string>
 
 #include "safety_test_support.h"
+#include "stewart/model/kinematics.h"
 #include "stewart/safety/clp_reference_qp.h"
 #include "stewart/safety/two_constraint_qp.h"
 
@@ -76,6 +78,127 @@ TEST(Degenerate, AtRestOutsideThePositionSetSteersBackAndIsFlagged) {
       EXPECT_LT((f - f_at_rest).cwiseAbs().maxCoeff(), 1e3 * qd_size + 1e-9) << where;
     }
   }
+}
+
+// The same for a leg beyond its stroke band (the stroke drawn in by
+// leg_stroke.margin_m): the energy barrier of the leg cannot act at rest, the
+// leg's recovery barrier h_r = ld_i + phi(l_i - l_lower) steers it back
+// (Ldd_i = H(:, i)^T qdd + (J_l-dot qd)_i > 0), with the shipped config
+// (each barrier checked), bounded and continuous in qd.
+Vector6d PoseWithLegsBelowTheBand(const StackConfig& config, double beyond_m) {
+  const double lower = LegStrokeBandOf(config.platform, config.safety.leg_stroke).lower_m;
+  Vector6d q = config.home_pose;
+  while (InverseKinematics(config.platform, q).minCoeff() > lower - beyond_m) q(2) -= 1e-5;
+  return q;
+}
+
+TEST(Degenerate, AtRestWithALegBeyondItsBandSteersItBackAndIsFlagged) {
+  const StackConfig& config = DefaultConfig();
+  const Vector6d q = PoseWithLegsBelowTheBand(config, 0.002);
+  const double lower = LegStrokeBandOf(config.platform, config.safety.leg_stroke).lower_m;
+  const Vector6d leg_length = InverseKinematics(config.platform, q);
+  ASSERT_TRUE(LegLengthsWithinStroke(config.platform, leg_length));
+  for (const SafetyVariant variant : {SafetyVariant::kClosedForm, SafetyVariant::kUncomposed}) {
+    SafetyConfig s = config.safety;
+    s.variant = variant;
+    SafetyFilter filter(config.platform, s, config.actuators);
+    std::mt19937 rng(6);
+    std::normal_distribution<double> noise(0.0, 1.0);
+    Vector6d f_at_rest = Vector6d::Zero();
+    for (const double qd_size : {0.0, 1e-9, 1e-6, 1e-4}) {
+      Vector6d qd;
+      for (int i = 0; i < 6; ++i) qd(i) = qd_size * noise(rng);
+      const DynamicsTerms t = EvaluateDynamics(config.platform, q, qd);
+      SafetyDiagnostics d;
+      const Vector6d f = filter.Step(q, qd, HoverForce(q), &d);
+      const std::string where = ToString(variant) + " |qd| ~ " + std::to_string(qd_size);
+      ASSERT_TRUE(f.allFinite()) << where;
+      EXPECT_TRUE(d.barriers.outside_position_set) << where;
+      EXPECT_TRUE(d.flags & kFlagOutsideSafeSet) << where;
+      EXPECT_FALSE(d.infeasible) << where;
+      EXPECT_FALSE(d.flags & kFlagFallback) << where;
+      EXPECT_TRUE(d.flags & kFlagFilterActive) << where;
+      const Vector6d qdd = ForwardDynamics(
+          t, f + LegViscousFriction(filter.leg_friction_nspm(), t.H.transpose() * qd));
+      const Vector6d leg_accel = t.H.transpose() * qdd + t.leg_bias_accel_mps2;
+      for (int i = 0; i < kNumLegs; ++i) {
+        if (leg_length(i) >= lower) continue;
+        const VelocityBarrierSpec& r =
+            filter.constraints().velocity[static_cast<size_t>(6 + 2 * i)];
+        ASSERT_EQ(r.name, "leg" + std::to_string(i) + "_lower_recovery");
+        double phi = 0.0, slope = 0.0;
+        RecoveryTarget(r, leg_length(i) - lower, &phi, &slope);
+        // Its own condition (each barrier checked): dh_r >= -gamma h_r with
+        // h_r = ld + phi, dh_r = Ldd + phi' ld; at rest Ldd >= -gamma phi > 0.
+        const double ld = t.H.col(i).dot(qd);
+        const double gamma = s.velocity_rate_per_s;
+        EXPECT_GT(leg_accel(i) + slope * ld, -gamma * (ld + phi) + 1e-3 * gamma * phi)
+            << where << " leg " << i;
+        EXPECT_GT(leg_accel(i), 0.0) << where << " leg " << i;
+      }
+      EXPECT_LE(f.cwiseAbs().maxCoeff(), config.actuators.force_limit_n + 1e-9) << where;
+      if (qd_size == 0.0) f_at_rest = f;
+      EXPECT_LT((f - f_at_rest).cwiseAbs().maxCoeff(), 1e3 * qd_size + 1e-9) << where;
+    }
+  }
+}
+
+// Inside the band a leg's recovery barrier is out of the group: wherever
+// every leg is inside, the filter answers bit for bit as without them.
+TEST(Degenerate, InsideTheBandTheLegsRecoveryBarriersChangeNothing) {
+  SafetyConfig without = RichSafetyConfig();
+  without.leg_stroke.recovery = false;
+  const SafetyFilter with_legs = MakeRichFilter(true);
+  without.force_limits_enabled = true;
+  const SafetyFilter axes_only(DefaultConfig().platform, without, DefaultConfig().actuators);
+  const double lower = LegStrokeBandOf(DefaultConfig().platform, without.leg_stroke).lower_m;
+  const double upper = LegStrokeBandOf(DefaultConfig().platform, without.leg_stroke).upper_m;
+  std::mt19937 rng(8);
+  int inside = 0, outside = 0;
+  for (int n = 0; n < 2000; ++n) {
+    const auto [q, qd, f_des, terms] = RandomFilterInput(&rng);
+    SafetyDiagnostics d_with, d_without;
+    const Vector6d f_with = with_legs.StepWithTerms(terms, q, qd, f_des, &d_with);
+    const Vector6d f_without = axes_only.StepWithTerms(terms, q, qd, f_des, &d_without);
+    const bool legs_inside =
+        (terms.leg_length_m.array() >= lower).all() && (terms.leg_length_m.array() <= upper).all();
+    int active_leg_rows = 0;
+    for (int i = 0; i < with_legs.constraints().num_velocity; ++i) {
+      const size_t k = static_cast<size_t>(i);
+      if (with_legs.constraints().velocity[k].source == PositionSource::kLegLength &&
+          d_with.barriers.velocity_active[k]) {
+        ++active_leg_rows;
+        EXPECT_EQ(d_with.barriers.w_velocity[k] >= 0.0, true);
+      } else if (!d_with.barriers.velocity_active[k]) {
+        EXPECT_EQ(d_with.barriers.w_velocity[k], 0.0);
+      }
+    }
+    if (legs_inside) {
+      ++inside;
+      EXPECT_EQ(active_leg_rows, 0) << "sample " << n;
+      EXPECT_EQ(f_with, f_without) << "sample " << n;
+    } else {
+      ++outside;
+      EXPECT_GT(active_leg_rows, 0) << "sample " << n;
+    }
+  }
+  EXPECT_GT(inside, 1000);
+  std::printf("[leg recovery] %d states with every leg inside the band, %d with one beyond\n",
+              inside, outside);
+}
+
+TEST(Degenerate, WithoutTheLegsRecoveryALegBeyondItsBandIsInfeasibleAndFlagged) {
+  const StackConfig& config = DefaultConfig();
+  SafetyConfig s = config.safety;
+  s.leg_stroke.recovery = false;
+  SafetyFilter filter(config.platform, s, config.actuators);
+  const Vector6d q = PoseWithLegsBelowTheBand(config, 0.002);
+  SafetyDiagnostics d;
+  const Vector6d f = filter.Step(q, Vector6d::Zero(), HoverForce(q), &d);
+  EXPECT_TRUE(f.allFinite());
+  EXPECT_FALSE(d.barriers.outside_position_set);
+  EXPECT_TRUE(d.flags & kFlagOutsideSafeSet);
+  EXPECT_TRUE(d.infeasible);
 }
 
 TEST(Degenerate, WithoutRecoveryBarriersAtRestOutsideIsInfeasibleAndFlagged) {

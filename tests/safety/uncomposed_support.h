@@ -43,9 +43,14 @@ inline SingleBarrierConditions EvaluateSingleBarrierConditions(const SafetyFilte
   }
   for (size_t i = 0; i < static_cast<size_t>(c.num_velocity); ++i) {
     const VelocityBarrierSpec& v = c.velocity[i];
+    if (!e.velocity_active[i]) {  // not in the QP: a row that always holds
+      s.psi_velocity[i] = 0.0;
+      s.n_velocity[i].setZero();
+      continue;
+    }
     s.psi_velocity[i] = c.velocity_rate_per_s * e.alpha_h_velocity[i] +
                         v.alpha_v * e.dh_velocity[i] - c.velocity_margin;
-    s.n_velocity[i] = v.alpha_v * v.sign * h_t_m_inv.col(v.axis);
+    s.n_velocity[i] = v.alpha_v * h_t_m_inv * VelocityBarrierGradient(v, terms.H);
   }
   return s;
 }

@@ -194,19 +194,25 @@ TEST(Uncomposed, AgreesWithTheComposedFilterAsKGrows) {
         // The smallest scaled margin of each group by a clear gap (k_max * gap
         // > 746: the other weights underflow to exactly 0), and only it may
         // carry a multiplier.
-        auto single = [](const double* alpha_h, const double* mu, int count, double gap) {
-          int smallest = 0;
-          for (int i = 1; i < count; ++i) smallest = alpha_h[i] < alpha_h[smallest] ? i : smallest;
+        // Rows out of the group (a leg's recovery barrier inside its band,
+        // `active` false) take no part.
+        auto single = [](const double* alpha_h, const double* mu, int count, double gap,
+                         const bool* active) {
+          auto in = [&](int i) { return active == nullptr || active[i]; };
+          int smallest = -1;
           for (int i = 0; i < count; ++i) {
-            if (i == smallest) continue;
+            if (in(i) && (smallest < 0 || alpha_h[i] < alpha_h[smallest])) smallest = i;
+          }
+          for (int i = 0; i < count; ++i) {
+            if (i == smallest || !in(i)) continue;
             if (alpha_h[i] - alpha_h[smallest] < gap || mu[i] != 0.0) return false;
           }
           return true;
         };
         if (!single(du.barriers.alpha_h_position.data(), du.mu_position.data(), c.num_position,
-                    1e-4) ||
+                    1e-4, nullptr) ||
             !single(du.barriers.alpha_h_velocity.data(), du.mu_velocity.data(), c.num_velocity,
-                    5e-4)) {
+                    5e-4, du.barriers.velocity_active.data())) {
           continue;
         }
         // The other rows must have slack at F* (the composed QP at large k
@@ -220,6 +226,7 @@ TEST(Uncomposed, AgreesWithTheComposedFilterAsKGrows) {
         }
         for (int i = 0; i < c.num_velocity; ++i) {
           const size_t k = static_cast<size_t>(i);
+          if (!du.barriers.velocity_active[k]) continue;  // no row
           if (du.mu_velocity[k] == 0.0 && at_f.psi_velocity[k] < 1e-6) slack = false;
         }
         if (!slack) continue;
@@ -278,10 +285,30 @@ TEST(UncomposedDegenerate, AtRestOnlyVelocityRowsAct) {
   for (int i = 0; i < at_f.num_velocity; ++i) {
     EXPECT_GE(at_f.psi_velocity[static_cast<size_t>(i)], -1e-9);
   }
-  // Only xd_upper is pushed.
+  // xd_upper is pushed. The legs' recovery rows, Ldd_i >= -gamma kappa h_i at
+  // rest (gamma = 1 here), bind too (the correction along M^-1 e_x tilts the
+  // platform), and zd_upper with them; every row that acts holds with
+  // equality (complementarity).
+  bool x_upper_acts = false;
   for (int i = 0; i < at_f.num_velocity; ++i) {
-    const bool x_upper = filter.constraints().velocity[static_cast<size_t>(i)].name == "xd_upper";
-    EXPECT_EQ(d.mu_velocity[static_cast<size_t>(i)] > 0.0, x_upper);
+    const size_t k = static_cast<size_t>(i);
+    const VelocityBarrierSpec& v = filter.constraints().velocity[k];
+    if (!(d.mu_velocity[k] > 0.0)) continue;
+    x_upper_acts = x_upper_acts || v.name == "xd_upper";
+    EXPECT_NEAR(at_f.psi_velocity[k], 0.0, 1e-9) << v.name;
+  }
+  EXPECT_TRUE(x_upper_acts);
+  // Without the legs' recovery barriers, xd_upper alone.
+  SafetyConfig no_leg_recovery = RichSafetyConfig();
+  no_leg_recovery.variant = SafetyVariant::kUncomposed;
+  no_leg_recovery.leg_stroke.recovery = false;
+  no_leg_recovery.force_limits_enabled = false;
+  SafetyFilter axes_only(DefaultConfig().platform, no_leg_recovery, DefaultConfig().actuators);
+  SafetyDiagnostics d_axes;
+  axes_only.Step(q, qd, f_des, &d_axes);
+  for (int i = 0; i < axes_only.constraints().num_velocity; ++i) {
+    const size_t k = static_cast<size_t>(i);
+    EXPECT_EQ(d_axes.mu_velocity[k] > 0.0, axes_only.constraints().velocity[k].name == "xd_upper");
   }
 }
 

@@ -23,6 +23,9 @@ struct DynamicsTerms {
   Vector6d G;     ///< gravity generalised force dV/dq
   Matrix6d H;     ///< J_l^T: maps leg forces to generalised forces
   Vector6d leg_length_m;
+  /// J_l-dot qd (m/s^2): the leg accelerations at qdd = 0, so that
+  /// Ldd = H^T qdd + leg_bias_accel_mps2 (per leg, n . a_bias + L |nd|^2).
+  Vector6d leg_bias_accel_mps2;
 };
 
 /// Evaluates M, C qd, G and H at (q, qd). No heap allocation.

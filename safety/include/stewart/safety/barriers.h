@@ -7,7 +7,8 @@
 // Position barrier i (NOTES.md, paper eqs. 7-11), units J and W:
 //   h_D,i  = -1/2 qd^T M qd + alpha_e,i h_i(q)
 //   dh_D,i = -qd^T (H F - G) + alpha_e,i (dh_i/dq) qd
-// Velocity barrier i (paper eqs. 12-14), a_i = dh_v,i/dqd = sign_i e_j:
+// Velocity barrier i (paper eqs. 12-14), a_i = dh_v,i/dqd = sign_i e_j (or
+// sign_i H(:, i) for a leg's recovery barrier, below):
 //   dh_v,i = a_i^T M^-1 (H F - C qd - G)
 // Group composition (alpha-weighted LSE, log_sum_exp.h), per group:
 //   h_c = LSE_k(alpha_i h_i),  psi = sum_i alpha_i w_i dh_i(F_des) + gamma h_c,
@@ -19,9 +20,14 @@
 // H F + d^ above, and each dh_i is taken at the worst d within k_sigma
 // standard deviations of d^ (entry by entry, so for any correlation):
 //   dh_D,i -= k_sigma sum_j |qd_j| sigma_j,
-//   dh_v,i -= k_sigma sum_j |(M^-1 a_i)_j| sigma_j.
-// Recovery barrier of an axis position limit (constraint_set.h), velocity
-// group: h_r = sign qd_j + kappa h(q), dh_r = sign qdd_j + kappa sign qd_j.
+//   dh_v,i -= k_sigma sum_j |(M^-1 a_i)_j| sigma_j
+// (except a leg's recovery barrier: d^ alone, barriers.cc says why).
+// Recovery barrier of a position limit (constraint_set.h), velocity group:
+//   axis j: h_r = sign qd_j + phi(h(q)), dh_r = sign qdd_j + phi' sign qd_j
+//   leg i:  h_r = sign ld_i + phi(h(l)),
+//           dh_r = sign (H(:, i)^T qdd + (J_l-dot qd)_i) + phi' sign ld_i
+// (a_i = sign H(:, i), so g_v and the worst case over d take the same form),
+// a leg's in the group only while its leg is beyond the band (velocity_active).
 #include <array>
 
 #include "stewart/model/disturbance.h"
@@ -41,6 +47,11 @@ struct BarrierEvaluation {
   std::array<double, kMaxVelocityBarriers> alpha_h_velocity{};  ///< alpha_i h_v,i (m/s^2)
   std::array<double, kMaxVelocityBarriers> w_velocity{};
   std::array<double, kMaxVelocityBarriers> dh_velocity{};  ///< dh_v,i at F_des (m/s^2)
+  /// Whether velocity barrier i is in the group this step: a leg's recovery
+  /// barrier only while its leg is beyond its band (its h(l) < 0); inside,
+  /// the leg's energy barrier guards it and the recovery barrier is left out
+  /// (w_i = 0, no condition, no QP row), as if it did not exist.
+  std::array<bool, kMaxVelocityBarriers> velocity_active{};
   // Composed (zero when the group is empty).
   double h_pos = 0.0;  ///< composed position barrier (W)
   double h_vel = 0.0;  ///< composed velocity barrier (m/s^2)

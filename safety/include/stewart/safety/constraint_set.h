@@ -7,10 +7,13 @@
 //                                                               or l_min + margin)
 // with sign = -1 for an upper and +1 for a lower limit. Velocity constraints
 // h_v(qd) = sign (qd_j - limit) >= 0 (m/s or rad/s). Recovery constraints,
-// one per axis position limit (velocity group, docs/safety.md "Outside the
-// safe set"): h_r = sign qd_j + phi(h(q)) >= 0 (m/s) with phi(h) = kappa h
-// inside (h >= 0) and v_r tanh(kappa h / v_r) outside, so the speed back
-// into the set stays below v_r, half the axis's smallest velocity limit.
+// one per position limit (velocity group, docs/safety.md "Outside the safe
+// set"): h_r = sign r + phi(h(q)) >= 0 (m/s) with r the rate of the limited
+// quantity (qd_j for an axis, the leg speed ld_i = J_l(i,:) qd for a leg),
+// phi(h) = kappa h inside (h >= 0) and v_r tanh(kappa h / v_r) outside, so
+// the speed back into the set stays below v_r: half the axis's smallest
+// velocity limit, and for a leg half the smallest velocity limit of any
+// translational axis.
 #include <array>
 #include <cmath>
 #include <string>
@@ -23,8 +26,8 @@ namespace stewart::safety {
 
 /// Capacity: a lower and an upper limit per axis, and per leg.
 constexpr int kMaxPositionBarriers = 2 * kNumAxes + 2 * kNumLegs;
-/// Velocity limits and the recovery barriers of the axis position limits.
-constexpr int kMaxVelocityBarriers = 4 * kNumAxes;
+/// Velocity limits and the recovery barriers of the position limits.
+constexpr int kMaxVelocityBarriers = 4 * kNumAxes + 2 * kNumLegs;
 
 enum class PositionSource { kAxis, kLegLength };
 
@@ -38,19 +41,29 @@ struct PositionBarrierSpec {
   std::string name;      ///< e.g. "x_upper", "leg3_lower"
 };
 
+/// h_v = sign r + (limit or phi) with r = a^T qd, a = dh_v/dqd: sign e_j for
+/// an axis, sign J_l(i,:)^T = sign H(:, i) for a leg (a leg's only velocity
+/// barrier is its stroke's recovery barrier).
 struct VelocityBarrierSpec {
-  int axis = 0;
+  PositionSource source = PositionSource::kAxis;
+  int index = 0;  ///< axis of qd, or leg
   double sign = -1.0;
   double limit = 0.0;    ///< m/s or rad/s (unused by a recovery barrier)
   double alpha_v = 1.0;  ///< class-K gain (1/s)
-  std::string name;      ///< e.g. "zd_upper", "z_upper_recovery"
-  /// A recovery barrier: the index of its axis position barrier, whose
-  /// h(q) = sign (q_j - limit) it reads; -1 for a velocity limit.
+  std::string name;      ///< e.g. "zd_upper", "z_upper_recovery", "leg3_lower_recovery"
+  /// A recovery barrier: the index of its position barrier, whose h(q) it
+  /// reads (same source and index); -1 for a velocity limit.
   int recovery_of = -1;
   double recovery_gain_per_s = 0.0;  ///< kappa (1/s)
-  /// v_r (m/s or rad/s); 0: the axis has no velocity limit, phi stays linear.
+  /// v_r (m/s or rad/s); 0: no velocity limit to stay within, phi stays linear.
   double recovery_speed = 0.0;
 };
+
+/// a_i = dh_v,i/dqd (module comment): sign e_j, or sign H(:, i) for a leg.
+inline Vector6d VelocityBarrierGradient(const VelocityBarrierSpec& s, const Matrix6d& H) {
+  if (s.source == PositionSource::kLegLength) return s.sign * H.col(s.index);
+  return s.sign * Vector6d::Unit(s.index);
+}
 
 /// phi(h) of a recovery barrier and its derivative dphi/dh.
 inline void RecoveryTarget(const VelocityBarrierSpec& s, double h, double* phi, double* dphi_dh);
@@ -69,6 +82,9 @@ struct ConstraintSet {
   /// within this many standard deviations of the estimate (barriers.h).
   double disturbance_sigma = 0.0;
   bool has_recovery = false;  ///< recovery barriers are in the velocity group
+  /// The leg-stroke barriers have recovery barriers too (leg_stroke enabled
+  /// and recovery_gain_per_s > 0).
+  bool has_leg_recovery = false;
   /// gamma of each group's condition Psi_c = dh_c + gamma h_c (1/s; the
   /// paper's is 1): a condition missing an acceleration error e leaves the
   /// composed barrier at about -e / gamma (docs/safety.md "Model error").

@@ -28,6 +28,10 @@ struct LegStrokeLimitConfig {
   double margin_m = 0.0;  ///< kept from each stroke end
   double alpha_e = 1.0;
   double alpha = 1.0;
+  /// Each leg-stroke barrier gets a recovery barrier (with
+  /// recovery_gain_per_s > 0): a leg beyond the band is steered back
+  /// (docs/safety.md, "Outside the safe set").
+  bool recovery = true;
 };
 
 /// kUncomposed: every barrier its own condition, no LSE (docs/safety.md,
