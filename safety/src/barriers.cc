@@ -129,10 +129,10 @@ void EvaluatePreparedBarriers(const ConstraintSet& c, const Vector6d& q, const V
         RecoveryTarget(s, h_position, &phi, &dphi_dh);
         e.h_velocity[k] = s.sign * rate_of(s) + phi;
         recovery_slope[k] = dphi_dh;
-        // Inside its band a leg's energy barrier guards it; its recovery
-        // barrier would only add a second, far more conservative condition
-        // (the worst case over d maps a torque's uncertainty through the
-        // leg's lever arm: tens of m/s^2 on the light platform).
+        // Inside its band a leg's energy barrier guards it, and every run
+        // that keeps its legs there stays what it was without the recovery
+        // barriers (always in the group they made 455 of 1000 exact random
+        // runs infeasible at times, docs/safety.md).
         e.velocity_active[k] = s.source == PositionSource::kAxis || h_position < 0.0;
       }
       e.alpha_h_velocity[k] = s.alpha_v * e.h_velocity[k];
@@ -191,9 +191,10 @@ void EvaluatePreparedBarriers(const ConstraintSet& c, const Vector6d& q, const V
         const double leg_accel = column.dot(rhs.col(0)) + terms.leg_bias_accel_mps2(s.index);
         // d^ but not its worst case: through the leg's lever arm a torque's
         // uncertainty is tens of m/s^2 of leg acceleration on the light
-        // platform, and asking for that outward would leave no zdd within
-        // zd's limit (every leg beyond its band infeasible). The recovery
-        // barrier steers back; the energy barrier is the leg's invariance.
+        // platform, and asking for that outward conflicts with zd's limit
+        // (measured: a pushed platform stayed 4 mm beyond, infeasible
+        // throughout; docs/safety.md). The recovery barrier steers back; the
+        // energy barrier is the leg's invariance.
         e.dh_velocity[k] = s.sign * leg_accel;
       }
       if (s.recovery_of >= 0) e.dh_velocity[k] += recovery_slope[k] * s.sign * rate_of(s);
