@@ -221,6 +221,35 @@ void BM_ForceLimitedFullStepBoxActiveOnly(benchmark::State& state) {
 }
 BENCHMARK(BM_ForceLimitedFullStepBoxActiveOnly);
 
+// (e) on states where the force-limited conditions have no common point
+// (force limits of 1 N, a quarter of the hover force; the set with 20 times
+// the accelerations): the steps that relax the velocity row by bisection
+// (SafetyFilter::RelaxVelocityLeast), the rare worst case.
+void BM_ForceLimitedFullStepInfeasibleOnly(benchmark::State& state) {
+  SafetyConfig s = DefaultStackConfig().safety;
+  s.force_limits_enabled = true;
+  ActuatorConfig weak = DefaultStackConfig().actuators;
+  weak.force_limit_n = 1.0;
+  SafetyFilter filter(DefaultStackConfig().platform, s, weak);
+  std::vector<const Sample*> infeasible;
+  SafetyDiagnostics d;
+  for (const Sample& x : HardSamples()) {
+    filter.Step(x.q, x.qd, x.f_des, &d);
+    if (d.infeasible && !(d.flags & kFlagFallback)) infeasible.push_back(&x);
+  }
+  if (infeasible.empty()) {
+    state.SkipWithError("no state of the set is infeasible within the force limits");
+    return;
+  }
+  size_t i = 0;
+  for (auto _ : state) {
+    const Sample& x = *infeasible[i++ % infeasible.size()];
+    benchmark::DoNotOptimize(filter.Step(x.q, x.qd, x.f_des, &d));
+  }
+  state.counters["states"] = static_cast<double>(infeasible.size());
+}
+BENCHMARK(BM_ForceLimitedFullStepInfeasibleOnly);
+
 // The un-composed QP (every barrier its own row, dual active set), full
 // step, unlimited and force-limited: what dropping the LSE costs per step.
 void BM_UncomposedFullStep(benchmark::State& state) {

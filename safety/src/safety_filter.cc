@@ -592,11 +592,60 @@ void SafetyFilter::SolveForceLimited(const StepInput& in, FilterWorkspace* ws,
       ApplySafeStop(in, d);
       return;
     }
+    RelaxVelocityLeast(y0, ws);
   }
   d->mu_p = ConditionMultiplier(r.mu.data(), rows.p, rows.p_norm);
   d->mu_v = ConditionMultiplier(r.mu.data(), rows.v, rows.v_norm);
   d->f_safe = ForceFromQpSolution(ws->metric_map, r.x, qp.x0, in.f_des);
   ReportQpSolution(force_limits_ ? r.mu.data() + rows.box : nullptr, d);
+}
+
+void SafetyFilter::RelaxVelocityLeast(const Vector6d& y0, FilterWorkspace* ws) const {
+  TwoConstraintProblem& problem = ws->problem;
+  if (!problem.has_v || !(problem.g_v.norm() > kZeroNormal)) return;
+  // How far the answer without the velocity row (position and box) falls
+  // short of it: Psi_v + g~_v^T (y - y0) < 0. Relaxing the row by that much
+  // keeps this answer feasible; the least relaxation the position row and
+  // the box allow lies in [0, shortfall]. Dropping the row instead returns
+  // the point of the box nearest F_des: F_des itself when it is inside,
+  // which outside the position set (the recovery barriers in the velocity
+  // row) is a pass-through of the command the recovery needed changed.
+  const double psi_v = problem.psi_v;
+  const double shortfall = -(psi_v + problem.g_v.dot(ws->composed.result.x - y0));
+  if (!(shortfall > 0.0)) return;  // that answer meets the velocity row too
+  // Bisection on the relaxation: each try is one QP (under 1 us), and only
+  // infeasible steps pay for them (docs/safety.md, "The least relaxation of
+  // the velocity row").
+  ProjectionResult best = ws->composed.result;
+  QpRows best_rows = ws->composed.rows;
+  double feasible = shortfall, infeasible = 0.0;
+  bool improved = false;
+  for (int i = 0; i < kMaxRelaxationSteps && feasible - infeasible > kRelaxationRelTol * shortfall;
+       ++i) {
+    const double relaxation = 0.5 * (feasible + infeasible);
+    problem.psi_v = psi_v + relaxation;
+    ProjectionResult& r = ws->composed.result;
+    r.status = ProjectionStatus::kInfeasible;
+    if (PoseQp(y0, ConditionGroups::kAll, ws)) r = SolveProjectionQp(ws->composed.qp);
+    if (r.status == ProjectionStatus::kOptimal) {
+      feasible = relaxation;
+      best = r;
+      best_rows = ws->composed.rows;
+      improved = true;
+    } else {
+      infeasible = relaxation;
+    }
+  }
+  // The QP left in ws is the one its answer solves.
+  if (improved) {
+    problem.psi_v = psi_v + feasible;
+    PoseQp(y0, ConditionGroups::kAll, ws);
+  } else {
+    PoseQp(y0, ConditionGroups::kPositionOnly, ws);
+  }
+  problem.psi_v = psi_v;
+  ws->composed.result = best;
+  ws->composed.rows = best_rows;
 }
 
 void SafetyFilter::SolveReference(const StepInput& in, FilterWorkspace* ws,

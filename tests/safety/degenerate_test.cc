@@ -350,6 +350,111 @@ TEST(Degenerate, ForceLimitsThatMakeTheConditionsInfeasibleAreReported) {
   EXPECT_LE(f.cwiseAbs().maxCoeff(), 0.5 + 1e-12);
 }
 
+// Below a lower z limit with force limits too small to lift the platform:
+// the recovery condition cannot be met within the box. The answer misses it
+// as little as the box allows (at the box's best, within the relaxation's
+// tolerance). Without the velocity row, the nearest point of the box to a
+// nominal that lets the platform drop would be that nominal itself.
+TEST(Degenerate, InfeasibleOutsideTheSetTheBoxDoesItsBestForTheRecovery) {
+  SafetyConfig s = RichSafetyConfig();
+  s.force_limits_enabled = true;
+  ActuatorConfig weak = DefaultConfig().actuators;
+  weak.force_limit_n = 1.0;  // hovering takes 3.8 N per leg
+  const SafetyFilter filter(DefaultConfig().platform, s, weak);
+  const PositionBarrierSpec* z_lower = nullptr;
+  for (int i = 0; i < filter.constraints().num_position; ++i) {
+    const PositionBarrierSpec& p = filter.constraints().position[static_cast<size_t>(i)];
+    if (p.source == PositionSource::kAxis && p.index == 2 && p.sign > 0.0) z_lower = &p;
+  }
+  ASSERT_NE(z_lower, nullptr);
+  Vector6d q = DefaultConfig().home_pose;
+  q(2) = z_lower->limit - 0.005;  // 5 mm below it, at rest
+  const Vector6d qd = Vector6d::Zero();
+  const DynamicsTerms t = EvaluateDynamics(DefaultConfig().platform, q, qd);
+  // The nominal lets the platform drop: a tenth of the hover force.
+  const Vector6d f_des = 0.1 * HoverForce(q);
+  ASSERT_LT(f_des.cwiseAbs().maxCoeff(), weak.force_limit_n);
+  SafetyDiagnostics d;
+  const Vector6d f = filter.StepWithTerms(t, q, qd, f_des, &d);
+  ASSERT_TRUE(f.allFinite());
+  EXPECT_TRUE(d.barriers.outside_position_set);
+  EXPECT_TRUE(d.infeasible);
+  EXPECT_TRUE(d.flags & kFlagInfeasible);
+  EXPECT_LE(f.cwiseAbs().maxCoeff(), weak.force_limit_n + 1e-9);
+  // Psi_v is affine in F with gradient g_v: over the box alone (no position
+  // row outside the set) its best is at F_i = limit sign(g_v,i).
+  const Vector6d& g_v = d.barriers.g_v;
+  const auto psi_v_at = [&](const Vector6d& force) {
+    return d.barriers.psi_v + g_v.dot(force - d.f_nominal);
+  };
+  const Vector6d best = weak.force_limit_n * g_v.array().sign().matrix();
+  ASSERT_LT(psi_v_at(best), 0.0) << "the recovery must be out of the box's reach";
+  const double shortfall = -psi_v_at(f_des);
+  // The bisection's guarantee, and the QP's rounding.
+  EXPECT_GT(psi_v_at(f), psi_v_at(best) - 1.01 * kRelaxationRelTol * shortfall - 1e-9);
+  // It lifts as hard as the box allows.
+  const auto zdd = [&](const Vector6d& force) { return ForwardDynamics(t, force)(2); };
+  EXPECT_GT(zdd(f), zdd(f_des) + 1.0);
+  std::printf(
+      "[box best] Psi_v: F_des %.4g, answer %.4g, box best %.4g m/s^2; "
+      "zdd %.4g -> %.4g m/s^2\n",
+      psi_v_at(f_des), psi_v_at(f), psi_v_at(best), zdd(f_des), zdd(f));
+}
+
+// Wherever the force-limited conditions have no common point, the answer
+// keeps the position condition and the box and misses the velocity condition
+// by no more than any vertex of the box that keeps the position condition
+// does (the bisection's tolerance and rounding aside): the least relaxation,
+// checked against points the QP did not see.
+TEST(Degenerate, InfeasibleForceLimitedStepsMissTheVelocityConditionLeast) {
+  SafetyConfig s = RichSafetyConfig();
+  s.force_limits_enabled = true;
+  ActuatorConfig weak = DefaultConfig().actuators;
+  weak.force_limit_n = 1.0;  // a quarter of the hover force: often infeasible
+  const SafetyFilter filter(DefaultConfig().platform, s, weak);
+  std::mt19937 rng(61);
+  int relaxed = 0, with_position_row = 0;  // of 4000: 100 and 100
+  for (int n = 0; n < 4000; ++n) {
+    const FilterInput x = RandomFilterInput(&rng);
+    SafetyDiagnostics d;
+    const Vector6d f = filter.StepWithTerms(x.terms, x.q, x.qd, x.f_des, &d);
+    ASSERT_TRUE(f.allFinite()) << "sample " << n;
+    if (!d.infeasible || (d.flags & kFlagFallback)) continue;
+    ++relaxed;
+    const BarrierEvaluation& b = d.barriers;
+    const bool has_p = !b.outside_position_set;
+    with_position_row += has_p ? 1 : 0;
+    const auto psi_p_at = [&](const Vector6d& force) {
+      return b.psi_p + b.g_p.dot(force - d.f_nominal);
+    };
+    const auto psi_v_at = [&](const Vector6d& force) {
+      return b.psi_v + b.g_v.dot(force - d.f_nominal);
+    };
+    const double scale = std::fabs(b.psi_v) + b.g_v.norm() * (f - d.f_nominal).norm() + 1.0;
+    EXPECT_LE(f.cwiseAbs().maxCoeff(), weak.force_limit_n * (1.0 + 1e-9)) << "sample " << n;
+    if (has_p) {
+      const double p_scale = std::fabs(b.psi_p) + b.g_p.norm() * (f - d.f_nominal).norm() + 1.0;
+      EXPECT_GE(psi_p_at(f), -1e-9 * p_scale) << "sample " << n;
+    }
+    const double shortfall_bound = std::fabs(psi_v_at(f)) + std::fabs(b.psi_v);
+    for (int corner = 0; corner < 64; ++corner) {
+      Vector6d v;
+      for (int i = 0; i < kNumLegs; ++i) {
+        v(i) = (corner >> i & 1) ? weak.force_limit_n : -weak.force_limit_n;
+      }
+      if (has_p && psi_p_at(v) < 0.0) continue;
+      EXPECT_GE(psi_v_at(f),
+                psi_v_at(v) - 1.01 * kRelaxationRelTol * shortfall_bound - 1e-9 * scale)
+          << "sample " << n << " corner " << corner;
+    }
+  }
+  // Random poses are inside the position set: the position row is posed
+  // (InfeasibleOutsideTheSet... covers the box alone).
+  EXPECT_GT(with_position_row, 50);
+  std::printf("[least relaxation] %d infeasible force-limited states, %d with the position row\n",
+              relaxed, with_position_row);
+}
+
 // The QP-based variants return F_des itself, bit for bit, when no row acts:
 // not T T^-1 F_des, which differs by rounding and would read as an
 // intervention (active time, correction norm).

@@ -49,6 +49,13 @@ constexpr double kReferenceActiveRelTol = 1e-10;
 /// physical margin.
 constexpr double kPerBarrierRelTol = 1e-9;
 
+/// An infeasible force-limited step relaxes the velocity condition by the
+/// least amount the position condition and the force limits allow, found by
+/// bisection to this fraction of the shortfall of the answer without it, in
+/// at most kMaxRelaxationSteps QP solves (SafetyFilter::RelaxVelocityLeast).
+constexpr double kRelaxationRelTol = 1e-3;
+constexpr int kMaxRelaxationSteps = 12;
+
 class SafetyFilter {
  public:
   /// Throws InputError (a std::invalid_argument naming the config key) for an
@@ -214,6 +221,14 @@ class SafetyFilter {
   /// T^-1 F_des (MetricCoordinates, or a solve with T where M has no factor).
   bool PoseQp(const Vector6d& y0, ConditionGroups groups, FilterWorkspace* ws) const;
   void SolveForceLimited(const StepInput& in, FilterWorkspace* ws, SafetyDiagnostics* d) const;
+  /// Where the velocity condition, the position condition and the box have
+  /// no common point: replaces ws->composed's answer to the position row and
+  /// the box alone by the projection of y0 onto them with the velocity row
+  /// relaxed by the least amount they allow (within kRelaxationRelTol of the
+  /// shortfall of that answer), so that the velocity condition, which holds
+  /// the recovery barriers outside the position set, is missed as little as
+  /// the actuators allow.
+  void RelaxVelocityLeast(const Vector6d& y0, FilterWorkspace* ws) const;
   void SolveReference(const StepInput& in, FilterWorkspace* ws, SafetyDiagnostics* d) const;
   /// `out` posed from ws.barrier.inertia and ws.metric_map.
   bool PoseUncomposedQp(const StepInput& in, ConditionGroups groups, const FilterWorkspace& ws,
