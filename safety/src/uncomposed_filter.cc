@@ -3,6 +3,7 @@
 // active-set method. Kept in its own file: nothing here runs for the other
 // variants.
 #include <Eigen/Core>
+#include <array>
 #include <cmath>
 
 #include "stewart/model/linear_algebra6.h"
@@ -163,6 +164,55 @@ bool SafetyFilter::PoseUncomposedQp(const StepInput& in, ConditionGroups groups,
   return posable;
 }
 
+void SafetyFilter::RelaxUncomposedVelocityLeast(const StepInput& in, FilterWorkspace* ws) const {
+  UncomposedQpData& main = ws->uncomposed;  // the position rows' and the box's answer
+  UncomposedQpData& all = ws->velocity_alone;
+  // Every row; a velocity row whose normal is zero is left out (no force
+  // changes it), so this posing is used whether or not it is posable.
+  PoseUncomposedQp(in, ConditionGroups::kAll, *ws, &all);
+  // The rows hold unit normals: b_i - a_i^T y is the distance, in the
+  // metric, by which y misses row i. The largest over the velocity rows at
+  // the answer without them bounds the least common relaxation.
+  const ConstraintSet& c = constraints_;
+  std::array<double, kMaxVelocityBarriers> b0{};
+  double shortfall = 0.0;
+  for (int i = 0; i < c.num_velocity; ++i) {
+    const int row = all.rows.velocity_row[static_cast<size_t>(i)];
+    if (row < 0) continue;
+    b0[static_cast<size_t>(i)] = all.qp.b(row);
+    shortfall = std::fmax(shortfall, all.qp.b(row) - all.qp.a.row(row).dot(main.result.x));
+  }
+  if (!(shortfall > 0.0)) return;
+  const auto relax = [&](double relaxation) {
+    for (int i = 0; i < c.num_velocity; ++i) {
+      const int row = all.rows.velocity_row[static_cast<size_t>(i)];
+      if (row >= 0) all.qp.b(row) = b0[static_cast<size_t>(i)] - relaxation;
+    }
+  };
+  // Bisection on one relaxation shared by every velocity row (the least
+  // worst miss): as the composed filter's RelaxVelocityLeast.
+  double feasible = shortfall, infeasible = 0.0;
+  bool improved = false;
+  for (int i = 0; i < kMaxRelaxationSteps && feasible - infeasible > kRelaxationRelTol * shortfall;
+       ++i) {
+    const double relaxation = 0.5 * (feasible + infeasible);
+    relax(relaxation);
+    all.result = SolveProjectionQp(all.qp);
+    if (all.result.status == ProjectionStatus::kOptimal) {
+      feasible = relaxation;
+      main.result = all.result;
+      improved = true;
+    } else {
+      infeasible = relaxation;
+    }
+  }
+  if (!improved) return;
+  // The QP and rows left in `main` are the ones its answer solves.
+  relax(feasible);
+  main.qp = all.qp;
+  main.rows = all.rows;
+}
+
 void SafetyFilter::SolveUncomposed(const StepInput& in, FilterWorkspace* ws,
                                    SafetyDiagnostics* d) const {
   UncomposedQpData& main = ws->uncomposed;
@@ -180,12 +230,14 @@ void SafetyFilter::SolveUncomposed(const StepInput& in, FilterWorkspace* ws,
     d->infeasible = true;
     if (force_limits_) {
       // As the force-limited composed filter: keep the position rows and the
-      // limits, relax velocity; if that fails too, the safe stop.
+      // limits, relax the velocity rows least; if the position rows and the
+      // limits fail too, the safe stop.
       ok = SolvePosed(PoseUncomposedQp(in, ConditionGroups::kPositionOnly, *ws, &main), &main);
       if (!ok) {
         ApplySafeStop(in, d);
         return;
       }
+      RelaxUncomposedVelocityLeast(in, ws);
       y = r.x;
     } else {
       // As the closed form's fallback (SolveInfeasibleFallback), per row:

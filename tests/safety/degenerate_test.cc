@@ -356,49 +356,83 @@ TEST(Degenerate, ForceLimitsThatMakeTheConditionsInfeasibleAreReported) {
 // tolerance). Without the velocity row, the nearest point of the box to a
 // nominal that lets the platform drop would be that nominal itself.
 TEST(Degenerate, InfeasibleOutsideTheSetTheBoxDoesItsBestForTheRecovery) {
-  SafetyConfig s = RichSafetyConfig();
-  s.force_limits_enabled = true;
   ActuatorConfig weak = DefaultConfig().actuators;
   weak.force_limit_n = 1.0;  // hovering takes 3.8 N per leg
-  const SafetyFilter filter(DefaultConfig().platform, s, weak);
-  const PositionBarrierSpec* z_lower = nullptr;
-  for (int i = 0; i < filter.constraints().num_position; ++i) {
-    const PositionBarrierSpec& p = filter.constraints().position[static_cast<size_t>(i)];
-    if (p.source == PositionSource::kAxis && p.index == 2 && p.sign > 0.0) z_lower = &p;
-  }
-  ASSERT_NE(z_lower, nullptr);
-  Vector6d q = DefaultConfig().home_pose;
-  q(2) = z_lower->limit - 0.005;  // 5 mm below it, at rest
-  const Vector6d qd = Vector6d::Zero();
-  const DynamicsTerms t = EvaluateDynamics(DefaultConfig().platform, q, qd);
-  // The nominal lets the platform drop: a tenth of the hover force.
-  const Vector6d f_des = 0.1 * HoverForce(q);
-  ASSERT_LT(f_des.cwiseAbs().maxCoeff(), weak.force_limit_n);
-  SafetyDiagnostics d;
-  const Vector6d f = filter.StepWithTerms(t, q, qd, f_des, &d);
-  ASSERT_TRUE(f.allFinite());
-  EXPECT_TRUE(d.barriers.outside_position_set);
-  EXPECT_TRUE(d.infeasible);
-  EXPECT_TRUE(d.flags & kFlagInfeasible);
-  EXPECT_LE(f.cwiseAbs().maxCoeff(), weak.force_limit_n + 1e-9);
-  // Psi_v is affine in F with gradient g_v: over the box alone (no position
-  // row outside the set) its best is at F_i = limit sign(g_v,i).
-  const Vector6d& g_v = d.barriers.g_v;
-  const auto psi_v_at = [&](const Vector6d& force) {
-    return d.barriers.psi_v + g_v.dot(force - d.f_nominal);
+  // The composed closed form alone, with the per-barrier check that hands a
+  // broken barrier to the un-composed QP (as shipped), and the un-composed
+  // variant.
+  struct Case {
+    SafetyVariant variant;
+    bool check_each_barrier;
   };
-  const Vector6d best = weak.force_limit_n * g_v.array().sign().matrix();
-  ASSERT_LT(psi_v_at(best), 0.0) << "the recovery must be out of the box's reach";
-  const double shortfall = -psi_v_at(f_des);
-  // The bisection's guarantee, and the QP's rounding.
-  EXPECT_GT(psi_v_at(f), psi_v_at(best) - 1.01 * kRelaxationRelTol * shortfall - 1e-9);
-  // It lifts as hard as the box allows.
-  const auto zdd = [&](const Vector6d& force) { return ForwardDynamics(t, force)(2); };
-  EXPECT_GT(zdd(f), zdd(f_des) + 1.0);
-  std::printf(
-      "[box best] Psi_v: F_des %.4g, answer %.4g, box best %.4g m/s^2; "
-      "zdd %.4g -> %.4g m/s^2\n",
-      psi_v_at(f_des), psi_v_at(f), psi_v_at(best), zdd(f_des), zdd(f));
+  for (const Case& k :
+       {Case{SafetyVariant::kClosedForm, false}, Case{SafetyVariant::kClosedForm, true},
+        Case{SafetyVariant::kUncomposed, false}}) {
+    SafetyConfig s = RichSafetyConfig();
+    s.force_limits_enabled = true;
+    s.variant = k.variant;
+    s.check_each_barrier = k.check_each_barrier;
+    const SafetyFilter filter(DefaultConfig().platform, s, weak);
+    const std::string where = ToString(k.variant) + (k.check_each_barrier ? " checked" : "");
+    const PositionBarrierSpec* z_lower = nullptr;
+    for (int i = 0; i < filter.constraints().num_position; ++i) {
+      const PositionBarrierSpec& p = filter.constraints().position[static_cast<size_t>(i)];
+      if (p.source == PositionSource::kAxis && p.index == 2 && p.sign > 0.0) z_lower = &p;
+    }
+    ASSERT_NE(z_lower, nullptr);
+    Vector6d q = DefaultConfig().home_pose;
+    q(2) = z_lower->limit - 0.005;  // 5 mm below it, at rest
+    const Vector6d qd = Vector6d::Zero();
+    const DynamicsTerms t = EvaluateDynamics(DefaultConfig().platform, q, qd);
+    // The nominal lets the platform drop: a tenth of the hover force.
+    const Vector6d f_des = 0.1 * HoverForce(q);
+    ASSERT_LT(f_des.cwiseAbs().maxCoeff(), weak.force_limit_n);
+    SafetyDiagnostics d;
+    const Vector6d f = filter.StepWithTerms(t, q, qd, f_des, &d);
+    ASSERT_TRUE(f.allFinite()) << where;
+    EXPECT_TRUE(d.barriers.outside_position_set) << where;
+    EXPECT_TRUE(d.infeasible) << where;
+    EXPECT_TRUE(d.flags & kFlagInfeasible) << where;
+    EXPECT_FALSE(d.flags & kFlagFallback) << where;
+    EXPECT_LE(f.cwiseAbs().maxCoeff(), weak.force_limit_n + 1e-9) << where;
+    // Psi_v is affine in F with gradient g_v: over the box alone (no position
+    // row outside the set) its best is at F_i = limit sign(g_v,i).
+    const Vector6d& g_v = d.barriers.g_v;
+    const auto psi_v_at = [&](const Vector6d& force) {
+      return d.barriers.psi_v + g_v.dot(force - d.f_nominal);
+    };
+    const Vector6d best = weak.force_limit_n * g_v.array().sign().matrix();
+    ASSERT_LT(psi_v_at(best), 0.0) << "the recovery must be out of the box's reach";
+    const auto zdd = [&](const Vector6d& force) { return ForwardDynamics(t, force)(2); };
+    if (k.variant == SafetyVariant::kClosedForm && !k.check_each_barrier) {
+      // The bisection's guarantee, and the QP's rounding.
+      const double shortfall = -psi_v_at(f_des);
+      EXPECT_GT(psi_v_at(f), psi_v_at(best) - 1.01 * kRelaxationRelTol * shortfall - 1e-9);
+    }
+    // It lifts (nearly) as hard as the box allows.
+    EXPECT_GT(zdd(f), zdd(f_des) + 1.0) << where;
+    EXPECT_GT(zdd(f), zdd(best) - 0.05 * std::fabs(zdd(best))) << where;
+    std::printf(
+        "[box best] %s: Psi_v: F_des %.4g, answer %.4g, box best %.4g m/s^2; "
+        "zdd %.4g -> %.4g m/s^2 (box best %.4g)\n",
+        where.c_str(), psi_v_at(f_des), psi_v_at(f), psi_v_at(best), zdd(f_des), zdd(f), zdd(best));
+  }
+}
+
+// The answer to `qp` without the rows `skip` marks, F = T y: the position
+// rows' and the box's answer, whose shortfall bounds the least relaxation.
+template <int MaxRows, typename Skip>
+Vector6d ForceWithoutRows(const ProjectionQpN<MaxRows>& qp, const Matrix6d& map, Skip skip) {
+  ProjectionQpN<MaxRows> kept;
+  kept.x0 = qp.x0;
+  for (int r = 0; r < qp.m; ++r) {
+    if (skip(r)) continue;
+    kept.a.row(kept.m) = qp.a.row(r);
+    kept.b(kept.m++) = qp.b(r);
+  }
+  const ProjectionResultN<MaxRows> result = SolveProjectionQp(kept);
+  EXPECT_EQ(result.status, ProjectionStatus::kOptimal);
+  return SafetyFilter::ForceFromQpSolution(map, result.x);
 }
 
 // Wherever the force-limited conditions have no common point, the answer
@@ -436,15 +470,20 @@ TEST(Degenerate, InfeasibleForceLimitedStepsMissTheVelocityConditionLeast) {
       const double p_scale = std::fabs(b.psi_p) + b.g_p.norm() * (f - d.f_nominal).norm() + 1.0;
       EXPECT_GE(psi_p_at(f), -1e-9 * p_scale) << "sample " << n;
     }
-    const double shortfall_bound = std::fabs(psi_v_at(f)) + std::fabs(b.psi_v);
+    const Matrix6d map = filter.MetricMap(x.terms);
+    ProjectionQp qp;
+    QpRows rows;
+    filter.BuildQp(map, b, d.f_nominal, &qp, &rows);
+    const double shortfall =
+        -psi_v_at(ForceWithoutRows(qp, map, [&](int r) { return r == rows.v; }));
+    ASSERT_GT(shortfall, 0.0) << "sample " << n;
     for (int corner = 0; corner < 64; ++corner) {
       Vector6d v;
       for (int i = 0; i < kNumLegs; ++i) {
         v(i) = (corner >> i & 1) ? weak.force_limit_n : -weak.force_limit_n;
       }
       if (has_p && psi_p_at(v) < 0.0) continue;
-      EXPECT_GE(psi_v_at(f),
-                psi_v_at(v) - 1.01 * kRelaxationRelTol * shortfall_bound - 1e-9 * scale)
+      EXPECT_GE(psi_v_at(f), psi_v_at(v) - 1.01 * kRelaxationRelTol * shortfall - 1e-9 * scale)
           << "sample " << n << " corner " << corner;
     }
   }
@@ -453,6 +492,72 @@ TEST(Degenerate, InfeasibleForceLimitedStepsMissTheVelocityConditionLeast) {
   EXPECT_GT(with_position_row, 50);
   std::printf("[least relaxation] %d infeasible force-limited states, %d with the position row\n",
               relaxed, with_position_row);
+}
+
+// The un-composed variant relaxes all its velocity rows by one distance in
+// the metric: the worst miss of its answer is no larger than that of any
+// vertex of the box that keeps its position rows.
+TEST(Degenerate, InfeasibleUncomposedStepsMissTheirWorstVelocityRowLeast) {
+  SafetyConfig s = RichSafetyConfig();
+  s.force_limits_enabled = true;
+  s.variant = SafetyVariant::kUncomposed;
+  ActuatorConfig weak = DefaultConfig().actuators;
+  weak.force_limit_n = 1.0;  // a quarter of the hover force: often infeasible
+  const SafetyFilter filter(DefaultConfig().platform, s, weak);
+  std::mt19937 rng(61);
+  int relaxed = 0;
+  for (int n = 0; n < 4000; ++n) {
+    const FilterInput x = RandomFilterInput(&rng);
+    SafetyDiagnostics d;
+    const Vector6d f = filter.StepWithTerms(x.terms, x.q, x.qd, x.f_des, &d);
+    ASSERT_TRUE(f.allFinite()) << "sample " << n;
+    if (!d.infeasible || (d.flags & kFlagFallback)) continue;
+    ++relaxed;
+    EXPECT_LE(f.cwiseAbs().maxCoeff(), weak.force_limit_n * (1.0 + 1e-9)) << "sample " << n;
+    const Matrix6d map = filter.MetricMap(x.terms);
+    UncomposedQp qp;
+    UncomposedQpRows rows;
+    filter.BuildUncomposedQp(x.terms, x.qd, map, d.barriers, d.f_nominal, &qp, &rows);
+    const auto slack = [&](int row, const Vector6d& force) {
+      return qp.a.row(row).dot(map.partialPivLu().solve(force)) - qp.b(row);
+    };
+    const auto worst_miss = [&](const Vector6d& force) {
+      double miss = 0.0;
+      for (int i = 0; i < filter.constraints().num_velocity; ++i) {
+        const int row = rows.velocity_row[static_cast<size_t>(i)];
+        if (row >= 0) miss = std::fmax(miss, -slack(row, force));
+      }
+      return miss;
+    };
+    const auto keeps_position = [&](const Vector6d& force, double tolerance) {
+      for (int i = 0; i < filter.constraints().num_position; ++i) {
+        const int row = rows.position_row[static_cast<size_t>(i)];
+        if (row >= 0 && slack(row, force) < -tolerance) return false;
+      }
+      return true;
+    };
+    EXPECT_TRUE(keeps_position(f, 1e-9 * (1.0 + qp.b.head(qp.m).cwiseAbs().maxCoeff())))
+        << "sample " << n;
+    const double miss = worst_miss(f);
+    const auto is_velocity_row = [&](int r) {
+      for (int i = 0; i < filter.constraints().num_velocity; ++i) {
+        if (rows.velocity_row[static_cast<size_t>(i)] == r) return true;
+      }
+      return false;
+    };
+    const double shortfall = worst_miss(ForceWithoutRows(qp, map, is_velocity_row));
+    for (int corner = 0; corner < 64; ++corner) {
+      Vector6d v;
+      for (int i = 0; i < kNumLegs; ++i) {
+        v(i) = (corner >> i & 1) ? weak.force_limit_n : -weak.force_limit_n;
+      }
+      if (!keeps_position(v, 0.0)) continue;
+      EXPECT_LE(miss, worst_miss(v) + 1.01 * kRelaxationRelTol * shortfall + 1e-9 * shortfall)
+          << "sample " << n << " corner " << corner;
+    }
+  }
+  EXPECT_GT(relaxed, 50);
+  std::printf("[least relaxation, un-composed] %d infeasible force-limited states\n", relaxed);
 }
 
 // The QP-based variants return F_des itself, bit for bit, when no row acts:

@@ -46,7 +46,8 @@ struct alignas(64) FilterWorkspace {
   ComposedQpData composed;       ///< force-limited variant and QP reference
   UncomposedQpData uncomposed;   ///< variant uncomposed: every row, or the position rows
   UncomposedQpData
-      velocity_alone;  ///< its unlimited fallback: the velocity rows, from the position rows' point
+      velocity_alone;  ///< its unlimited fallback: the velocity rows, from the position rows'
+                       ///< point; its force-limited one: every row, relaxed
   LegJacobianFactor leg_jacobian;  ///< reset by each step
   /// L_M (M = L_M L_M^T) as the metric map's computation left it this step.
   Matrix6d inertia_factor_l;

@@ -234,6 +234,12 @@ class SafetyFilter {
   bool PoseUncomposedQp(const StepInput& in, ConditionGroups groups, const FilterWorkspace& ws,
                         UncomposedQpData* out) const;
   void SolveUncomposed(const StepInput& in, FilterWorkspace* ws, SafetyDiagnostics* d) const;
+  /// The un-composed RelaxVelocityLeast: replaces ws->uncomposed's answer to
+  /// the position rows and the box alone by the projection of y0 onto them
+  /// and every velocity row relaxed by one common distance in the metric,
+  /// the least they allow (within kRelaxationRelTol of that answer's worst
+  /// miss). Uses ws->velocity_alone for the posing.
+  void RelaxUncomposedVelocityLeast(const StepInput& in, FilterWorkspace* ws) const;
   /// True when F breaks some barrier's own condition Psi_i(F) >= 0 (the rows
   /// of PoseUncomposedQp) beyond rounding (kPerBarrierRelTol).
   bool BreaksABarrierCondition(const StepInput& in, const FilterWorkspace& ws,
