@@ -221,21 +221,29 @@ void BM_ForceLimitedFullStepBoxActiveOnly(benchmark::State& state) {
 }
 BENCHMARK(BM_ForceLimitedFullStepBoxActiveOnly);
 
-// (e) on states where the force-limited conditions have no common point
-// (force limits of 1 N, a quarter of the hover force; the set with 20 times
-// the accelerations): the steps that relax the velocity row by bisection
-// (SafetyFilter::RelaxVelocityLeast), the rare worst case.
+// (e) on states outside the position set where the force-limited conditions
+// have no common point (the hard set moved 5 mm beyond x's upper limit, at
+// force limits of 1 N, a quarter of the hover force): the steps that relax
+// the velocity row by bisection (SafetyFilter::RelaxVelocityLeast), the rare
+// worst case. Arg 0: the same states inside the set (the row is dropped).
 void BM_ForceLimitedFullStepInfeasibleOnly(benchmark::State& state) {
   SafetyConfig s = DefaultStackConfig().safety;
   s.force_limits_enabled = true;
   ActuatorConfig weak = DefaultStackConfig().actuators;
   weak.force_limit_n = 1.0;
   SafetyFilter filter(DefaultStackConfig().platform, s, weak);
-  std::vector<const Sample*> infeasible;
+  const bool outside = state.range(0) != 0;
+  std::vector<Sample> infeasible;
   SafetyDiagnostics d;
-  for (const Sample& x : HardSamples()) {
+  for (Sample x : HardSamples()) {
+    if (outside) {
+      x.q(0) = 0.115;  // x <= 0.11 in the shipped config
+      x.terms = EvaluateDynamics(DefaultStackConfig().platform, x.q, x.qd);
+    }
     filter.Step(x.q, x.qd, x.f_des, &d);
-    if (d.infeasible && !(d.flags & kFlagFallback)) infeasible.push_back(&x);
+    if (d.infeasible && !(d.flags & kFlagFallback) && d.barriers.outside_position_set == outside) {
+      infeasible.push_back(x);
+    }
   }
   if (infeasible.empty()) {
     state.SkipWithError("no state of the set is infeasible within the force limits");
@@ -243,12 +251,12 @@ void BM_ForceLimitedFullStepInfeasibleOnly(benchmark::State& state) {
   }
   size_t i = 0;
   for (auto _ : state) {
-    const Sample& x = *infeasible[i++ % infeasible.size()];
+    const Sample& x = infeasible[i++ % infeasible.size()];
     benchmark::DoNotOptimize(filter.Step(x.q, x.qd, x.f_des, &d));
   }
   state.counters["states"] = static_cast<double>(infeasible.size());
 }
-BENCHMARK(BM_ForceLimitedFullStepInfeasibleOnly);
+BENCHMARK(BM_ForceLimitedFullStepInfeasibleOnly)->ArgName("outside")->Arg(1)->Arg(0);
 
 // The un-composed QP (every barrier its own row, dual active set), full
 // step, unlimited and force-limited: what dropping the LSE costs per step.

@@ -584,7 +584,11 @@ void SafetyFilter::SolveForceLimited(const StepInput& in, FilterWorkspace* ws,
   ws->y_des_ready = true;
   if (PoseQp(y0, ConditionGroups::kAll, ws)) r = SolveProjectionQp(qp);
   if (r.status != ProjectionStatus::kOptimal) {
-    // Keep the position condition and the limits, relax velocity.
+    // Keep the position condition and the limits, relax velocity: inside the
+    // position set drop it (the position barriers guard the limits), outside
+    // it, where the velocity row holds the recovery barriers and nothing else
+    // would act, miss it least. Missing it least inside too was measured
+    // worse on the P-16P legs (docs/safety.md).
     d->infeasible = true;
     r.status = ProjectionStatus::kInfeasible;
     if (PoseQp(y0, ConditionGroups::kPositionOnly, ws)) r = SolveProjectionQp(qp);
@@ -592,7 +596,7 @@ void SafetyFilter::SolveForceLimited(const StepInput& in, FilterWorkspace* ws,
       ApplySafeStop(in, d);
       return;
     }
-    RelaxVelocityLeast(y0, ws);
+    if (in.barriers.outside_position_set) RelaxVelocityLeast(y0, ws);
   }
   d->mu_p = ConditionMultiplier(r.mu.data(), rows.p, rows.p_norm);
   d->mu_v = ConditionMultiplier(r.mu.data(), rows.v, rows.v_norm);

@@ -230,14 +230,15 @@ void SafetyFilter::SolveUncomposed(const StepInput& in, FilterWorkspace* ws,
     d->infeasible = true;
     if (force_limits_) {
       // As the force-limited composed filter: keep the position rows and the
-      // limits, relax the velocity rows least; if the position rows and the
-      // limits fail too, the safe stop.
+      // limits, drop the velocity rows inside the position set and miss them
+      // least outside it; if the position rows and the limits fail too, the
+      // safe stop.
       ok = SolvePosed(PoseUncomposedQp(in, ConditionGroups::kPositionOnly, *ws, &main), &main);
       if (!ok) {
         ApplySafeStop(in, d);
         return;
       }
-      RelaxUncomposedVelocityLeast(in, ws);
+      if (in.barriers.outside_position_set) RelaxUncomposedVelocityLeast(in, ws);
       y = r.x;
     } else {
       // As the closed form's fallback (SolveInfeasibleFallback), per row:

@@ -222,12 +222,11 @@ class SafetyFilter {
   bool PoseQp(const Vector6d& y0, ConditionGroups groups, FilterWorkspace* ws) const;
   void SolveForceLimited(const StepInput& in, FilterWorkspace* ws, SafetyDiagnostics* d) const;
   /// Where the velocity condition, the position condition and the box have
-  /// no common point: replaces ws->composed's answer to the position row and
-  /// the box alone by the projection of y0 onto them with the velocity row
-  /// relaxed by the least amount they allow (within kRelaxationRelTol of the
-  /// shortfall of that answer), so that the velocity condition, which holds
-  /// the recovery barriers outside the position set, is missed as little as
-  /// the actuators allow.
+  /// no common point, outside the position set: replaces ws->composed's answer to the position row
+  /// and the box alone by the projection of y0 onto them with the velocity row relaxed by the least
+  /// amount they allow (within kRelaxationRelTol of the shortfall of that answer), so that the
+  /// velocity condition, which holds the recovery barriers outside the position set, is missed as
+  /// little as the actuators allow.
   void RelaxVelocityLeast(const Vector6d& y0, FilterWorkspace* ws) const;
   void SolveReference(const StepInput& in, FilterWorkspace* ws, SafetyDiagnostics* d) const;
   /// `out` posed from ws.barrier.inertia and ws.metric_map.
