@@ -108,20 +108,26 @@ void ExpectSteeredBackOnlyWithTheLegsRecovery(const std::optional<std::string>& 
   EXPECT_LT(without.final_margin_m, -5e-4);                     // and stayed beyond
   const AfterAPush with = PushBeyondTheBand(true, truth_name);
   ASSERT_TRUE(with.summary.completed) << with.summary.failure;
-  EXPECT_LT(with.summary.leg_stroke_worst_margin_m, -1e-3);  // pushed beyond too
+  // Pushed beyond too, but less deep: beyond the band the recovery rows are
+  // the velocity group, and where the box cannot meet them the filter misses
+  // them least instead of leaving the push alone.
+  EXPECT_LT(with.summary.leg_stroke_worst_margin_m, -5e-4);
+  EXPECT_GT(with.summary.leg_stroke_worst_margin_m,
+            without.summary.leg_stroke_worst_margin_m + 5e-4);
   EXPECT_LE(with.summary.endstop_hits, without.summary.endstop_hits);
   EXPECT_GE(with.final_margin_m, -back_within_m);  // back at the band
   EXPECT_LT(with.final_margin_m, 1e-3);            // and no further: the setpoint is beyond it
 }
 
-// Own plant: 2.5 mm beyond, back to 0.04 mm (0.76 mm without).
+// Own plant: 2.53 mm beyond without the legs' recovery, ending 0.76 mm
+// beyond; with it 0.83 mm at worst, back to 0.09 mm.
 TEST(LegStrokeBand, ALegPushedBeyondTheBandIsSteeredBack) {
   ExpectSteeredBackOnlyWithTheLegsRecovery(std::nullopt, 2e-4);
 }
 
-// Heavy corner: the push reaches the end stop (5 mm beyond; 12 end-stop hits
-// without, 2 with); without the recovery the legs stay on it (5.35 mm), with
-// it they settle 0.28 mm beyond the band.
+// Heavy corner: without the recovery the push reaches the end stop (5.5 mm
+// beyond, 12 end-stop hits) and the legs stay on it (5.35 mm); with it
+// 3.67 mm at worst, no end-stop hit, settling 0.23 mm beyond the band.
 TEST(LegStrokeBand, ALegPushedBeyondTheBandIsSteeredBackOnTheHeavyCorner) {
   ExpectSteeredBackOnlyWithTheLegsRecovery(std::string("bounds-heavy-corner"), 5e-4);
 }
