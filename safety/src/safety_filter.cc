@@ -4,10 +4,12 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <utility>
 
 #include "stewart/common/check.h"
 #include "stewart/model/linear_algebra6.h"
+#include "stewart/safety/least_relaxation.h"
 #include "stewart/safety/nominal_bound.h"
 #include "stewart/safety/pose_plausibility.h"
 
@@ -605,7 +607,7 @@ void SafetyFilter::SolveForceLimited(const StepInput& in, FilterWorkspace* ws,
 }
 
 void SafetyFilter::RelaxVelocityLeast(const Vector6d& y0, FilterWorkspace* ws) const {
-  TwoConstraintProblem& problem = ws->problem;
+  const TwoConstraintProblem& problem = ws->problem;
   if (!problem.has_v || !(problem.g_v.norm() > kZeroNormal)) return;
   // How far the answer without the velocity row (position and box) falls
   // short of it: Psi_v + g~_v^T (y - y0) < 0. Relaxing the row by that much
@@ -614,42 +616,32 @@ void SafetyFilter::RelaxVelocityLeast(const Vector6d& y0, FilterWorkspace* ws) c
   // the point of the box nearest F_des: F_des itself when it is inside,
   // which outside the position set (the recovery barriers in the velocity
   // row) is a pass-through of the command the recovery needed changed.
-  const double psi_v = problem.psi_v;
-  const double shortfall = -(psi_v + problem.g_v.dot(ws->composed.result.x - y0));
+  const double shortfall = -(problem.psi_v + problem.g_v.dot(ws->composed.result.x - y0));
   if (!(shortfall > 0.0)) return;  // that answer meets the velocity row too
-  // Bisection on the relaxation: each try is one QP (under 1 us), and only
-  // infeasible steps pay for them (docs/safety.md, "The least relaxation of
-  // the velocity row").
-  ProjectionResult best = ws->composed.result;
-  QpRows best_rows = ws->composed.rows;
-  double feasible = shortfall, infeasible = 0.0;
-  bool improved = false;
-  for (int i = 0; i < kMaxRelaxationSteps && feasible - infeasible > kRelaxationRelTol * shortfall;
-       ++i) {
-    const double relaxation = 0.5 * (feasible + infeasible);
-    problem.psi_v = psi_v + relaxation;
-    ProjectionResult& r = ws->composed.result;
-    r.status = ProjectionStatus::kInfeasible;
-    if (PoseQp(y0, ConditionGroups::kAll, ws)) r = SolveProjectionQp(ws->composed.qp);
-    if (r.status == ProjectionStatus::kOptimal) {
-      feasible = relaxation;
-      best = r;
-      best_rows = ws->composed.rows;
-      improved = true;
-    } else {
-      infeasible = relaxation;
-    }
-  }
-  // The QP left in ws is the one its answer solves.
-  if (improved) {
-    problem.psi_v = psi_v + feasible;
-    PoseQp(y0, ConditionGroups::kAll, ws);
+  // Posable: the position row was (its answer exists) and the velocity row
+  // has a normal. Its unit row a^T y >= b moves by relaxation / |g~_v|.
+  PoseQp(y0, ConditionGroups::kAll, ws);
+  ProjectionQp& qp = ws->composed.qp;
+  const int v = ws->composed.rows.v;
+  const double b0 = qp.b(v);
+  const double inv_norm = 1.0 / ws->composed.rows.v_norm;
+  // Each try is one QP (under 1 us), and only infeasible steps outside the
+  // set pay for them (docs/safety.md, "The least relaxation of the velocity
+  // row").
+  const std::optional<double> least = LeastRelaxation(shortfall, [&](double relaxation) {
+    qp.b(v) = b0 - relaxation * inv_norm;
+    const ProjectionResult r = SolveProjectionQp(qp);
+    if (r.status != ProjectionStatus::kOptimal) return false;
+    ws->composed.result = r;
+    return true;
+  });
+  // The QP left in ws is the one its answer solves (a failed try leaves the
+  // answer alone).
+  if (least) {
+    qp.b(v) = b0 - *least * inv_norm;
   } else {
     PoseQp(y0, ConditionGroups::kPositionOnly, ws);
   }
-  problem.psi_v = psi_v;
-  ws->composed.result = best;
-  ws->composed.rows = best_rows;
 }
 
 void SafetyFilter::SolveReference(const StepInput& in, FilterWorkspace* ws,

@@ -5,8 +5,10 @@
 #include <Eigen/Core>
 #include <array>
 #include <cmath>
+#include <optional>
 
 #include "stewart/model/linear_algebra6.h"
+#include "stewart/safety/least_relaxation.h"
 #include "stewart/safety/safety_filter.h"
 
 namespace stewart::safety {
@@ -189,26 +191,18 @@ void SafetyFilter::RelaxUncomposedVelocityLeast(const StepInput& in, FilterWorks
       if (row >= 0) all.qp.b(row) = b0[static_cast<size_t>(i)] - relaxation;
     }
   };
-  // Bisection on one relaxation shared by every velocity row (the least
-  // worst miss): as the composed filter's RelaxVelocityLeast.
-  double feasible = shortfall, infeasible = 0.0;
-  bool improved = false;
-  for (int i = 0; i < kMaxRelaxationSteps && feasible - infeasible > kRelaxationRelTol * shortfall;
-       ++i) {
-    const double relaxation = 0.5 * (feasible + infeasible);
+  // One relaxation shared by every velocity row (the least worst miss), as
+  // the composed filter's RelaxVelocityLeast.
+  const std::optional<double> least = LeastRelaxation(shortfall, [&](double relaxation) {
     relax(relaxation);
     all.result = SolveProjectionQp(all.qp);
-    if (all.result.status == ProjectionStatus::kOptimal) {
-      feasible = relaxation;
-      main.result = all.result;
-      improved = true;
-    } else {
-      infeasible = relaxation;
-    }
-  }
-  if (!improved) return;
+    if (all.result.status != ProjectionStatus::kOptimal) return false;
+    main.result = all.result;
+    return true;
+  });
+  if (!least) return;
   // The QP and rows left in `main` are the ones its answer solves.
-  relax(feasible);
+  relax(*least);
   main.qp = all.qp;
   main.rows = all.rows;
 }

@@ -454,6 +454,41 @@ FilterInput MaybeBeyondAnAxisLimit(const SafetyFilter& filter, FilterInput x, st
   return x;
 }
 
+constexpr double kWeakForceLimitN = 1.0;  // a quarter of the hover force: often infeasible
+
+SafetyFilter WeakBoxFilter(SafetyVariant variant) {
+  SafetyConfig s = RichSafetyConfig();
+  s.force_limits_enabled = true;
+  s.variant = variant;
+  ActuatorConfig weak = DefaultConfig().actuators;
+  weak.force_limit_n = kWeakForceLimitN;
+  return SafetyFilter(DefaultConfig().platform, s, weak);
+}
+
+// Vertex `corner` (0..63, one bit per leg) of the box |F_i| <= limit_n.
+Vector6d BoxVertex(int corner, double limit_n) {
+  Vector6d v;
+  for (int i = 0; i < kNumLegs; ++i) v(i) = (corner >> i & 1) ? limit_n : -limit_n;
+  return v;
+}
+
+// Calls check(n, x, f, d) for each step of `filter` that is infeasible and
+// not the safe stop, among `samples` random inputs (half of them beyond an
+// axis limit), once its answer is finite and inside the box.
+template <typename Check>
+void ForEachInfeasibleStep(const SafetyFilter& filter, int samples, Check&& check) {
+  std::mt19937 rng(61);
+  for (int n = 0; n < samples; ++n) {
+    const FilterInput x = MaybeBeyondAnAxisLimit(filter, RandomFilterInput(&rng), &rng);
+    SafetyDiagnostics d;
+    const Vector6d f = filter.StepWithTerms(x.terms, x.q, x.qd, x.f_des, &d);
+    ASSERT_TRUE(f.allFinite()) << "sample " << n;
+    if (!d.infeasible || (d.flags & kFlagFallback)) continue;
+    EXPECT_LE(f.cwiseAbs().maxCoeff(), kWeakForceLimitN * (1.0 + 1e-9)) << "sample " << n;
+    check(n, x, f, d);
+  }
+}
+
 // Wherever the force-limited conditions have no common point: outside the
 // position set the answer misses the velocity condition by no more than any
 // vertex of the box (the bisection's tolerance and rounding aside), checked
@@ -461,47 +496,35 @@ FilterInput MaybeBeyondAnAxisLimit(const SafetyFilter& filter, FilterInput x, st
 // and the answer is the position row's and the box's (measured better on the
 // P-16P legs, docs/safety.md).
 TEST(Degenerate, InfeasibleForceLimitedStepsMissTheVelocityConditionLeastOutside) {
-  SafetyConfig s = RichSafetyConfig();
-  s.force_limits_enabled = true;
-  ActuatorConfig weak = DefaultConfig().actuators;
-  weak.force_limit_n = 1.0;  // a quarter of the hover force: often infeasible
-  const SafetyFilter filter(DefaultConfig().platform, s, weak);
-  std::mt19937 rng(61);
+  const SafetyFilter filter = WeakBoxFilter(SafetyVariant::kClosedForm);
   int outside = 0, inside = 0;
-  for (int n = 0; n < 8000; ++n) {
-    const FilterInput x = MaybeBeyondAnAxisLimit(filter, RandomFilterInput(&rng), &rng);
-    SafetyDiagnostics d;
-    const Vector6d f = filter.StepWithTerms(x.terms, x.q, x.qd, x.f_des, &d);
-    ASSERT_TRUE(f.allFinite()) << "sample " << n;
-    if (!d.infeasible || (d.flags & kFlagFallback)) continue;
-    const BarrierEvaluation& b = d.barriers;
-    const auto psi_v_at = [&](const Vector6d& force) {
-      return b.psi_v + b.g_v.dot(force - d.f_nominal);
-    };
-    EXPECT_LE(f.cwiseAbs().maxCoeff(), weak.force_limit_n * (1.0 + 1e-9)) << "sample " << n;
-    const Matrix6d map = filter.MetricMap(x.terms);
-    ProjectionQp qp;
-    QpRows rows;
-    filter.BuildQp(map, b, d.f_nominal, &qp, &rows);
-    const Vector6d f_without = ForceWithoutRows(qp, map, [&](int r) { return r == rows.v; });
-    if (!b.outside_position_set) {
-      ++inside;
-      EXPECT_LT((f - f_without).norm(), 1e-6 * (1.0 + f_without.norm())) << "sample " << n;
-      continue;
-    }
-    ++outside;
-    const double shortfall = -psi_v_at(f_without);
-    ASSERT_GT(shortfall, 0.0) << "sample " << n;
-    const double scale = std::fabs(b.psi_v) + b.g_v.norm() * (f - d.f_nominal).norm() + 1.0;
-    for (int corner = 0; corner < 64; ++corner) {
-      Vector6d v;
-      for (int i = 0; i < kNumLegs; ++i) {
-        v(i) = (corner >> i & 1) ? weak.force_limit_n : -weak.force_limit_n;
-      }
-      EXPECT_GE(psi_v_at(f), psi_v_at(v) - 1.01 * kRelaxationRelTol * shortfall - 1e-9 * scale)
-          << "sample " << n << " corner " << corner;
-    }
-  }
+  ForEachInfeasibleStep(
+      filter, 8000,
+      [&](int n, const FilterInput& x, const Vector6d& f, const SafetyDiagnostics& d) {
+        const BarrierEvaluation& b = d.barriers;
+        const auto psi_v_at = [&](const Vector6d& force) {
+          return b.psi_v + b.g_v.dot(force - d.f_nominal);
+        };
+        const Matrix6d map = filter.MetricMap(x.terms);
+        ProjectionQp qp;
+        QpRows rows;
+        filter.BuildQp(map, b, d.f_nominal, &qp, &rows);
+        const Vector6d f_without = ForceWithoutRows(qp, map, [&](int r) { return r == rows.v; });
+        if (!b.outside_position_set) {
+          ++inside;
+          EXPECT_LT((f - f_without).norm(), 1e-6 * (1.0 + f_without.norm())) << "sample " << n;
+          return;
+        }
+        ++outside;
+        const double shortfall = -psi_v_at(f_without);
+        ASSERT_GT(shortfall, 0.0) << "sample " << n;
+        const double scale = std::fabs(b.psi_v) + b.g_v.norm() * (f - d.f_nominal).norm() + 1.0;
+        for (int corner = 0; corner < 64; ++corner) {
+          const Vector6d v = BoxVertex(corner, kWeakForceLimitN);
+          EXPECT_GE(psi_v_at(f), psi_v_at(v) - 1.01 * kRelaxationRelTol * shortfall - 1e-9 * scale)
+              << "sample " << n << " corner " << corner;
+        }
+      });
   EXPECT_GT(outside, 30);
   EXPECT_GT(inside, 50);
   std::printf("[least relaxation] infeasible force-limited states: %d outside, %d inside\n",
@@ -512,60 +535,47 @@ TEST(Degenerate, InfeasibleForceLimitedStepsMissTheVelocityConditionLeastOutside
 // velocity rows by one distance in the metric: the worst miss of its answer
 // is no larger than that of any vertex of the box. Inside, it drops them.
 TEST(Degenerate, InfeasibleUncomposedStepsMissTheirWorstVelocityRowLeastOutside) {
-  SafetyConfig s = RichSafetyConfig();
-  s.force_limits_enabled = true;
-  s.variant = SafetyVariant::kUncomposed;
-  ActuatorConfig weak = DefaultConfig().actuators;
-  weak.force_limit_n = 1.0;  // a quarter of the hover force: often infeasible
-  const SafetyFilter filter(DefaultConfig().platform, s, weak);
-  std::mt19937 rng(61);
+  const SafetyFilter filter = WeakBoxFilter(SafetyVariant::kUncomposed);
   int outside = 0, inside = 0;
-  for (int n = 0; n < 4000; ++n) {
-    const FilterInput x = MaybeBeyondAnAxisLimit(filter, RandomFilterInput(&rng), &rng);
-    SafetyDiagnostics d;
-    const Vector6d f = filter.StepWithTerms(x.terms, x.q, x.qd, x.f_des, &d);
-    ASSERT_TRUE(f.allFinite()) << "sample " << n;
-    if (!d.infeasible || (d.flags & kFlagFallback)) continue;
-    EXPECT_LE(f.cwiseAbs().maxCoeff(), weak.force_limit_n * (1.0 + 1e-9)) << "sample " << n;
-    const Matrix6d map = filter.MetricMap(x.terms);
-    UncomposedQp qp;
-    UncomposedQpRows rows;
-    filter.BuildUncomposedQp(x.terms, x.qd, map, d.barriers, d.f_nominal, &qp, &rows);
-    const auto slack = [&](int row, const Vector6d& force) {
-      return qp.a.row(row).dot(map.partialPivLu().solve(force)) - qp.b(row);
-    };
-    const auto worst_miss = [&](const Vector6d& force) {
-      double miss = 0.0;
-      for (int i = 0; i < filter.constraints().num_velocity; ++i) {
-        const int row = rows.velocity_row[static_cast<size_t>(i)];
-        if (row >= 0) miss = std::fmax(miss, -slack(row, force));
-      }
-      return miss;
-    };
-    const auto is_velocity_row = [&](int r) {
-      for (int i = 0; i < filter.constraints().num_velocity; ++i) {
-        if (rows.velocity_row[static_cast<size_t>(i)] == r) return true;
-      }
-      return false;
-    };
-    const Vector6d f_without = ForceWithoutRows(qp, map, is_velocity_row);
-    if (!d.barriers.outside_position_set) {
-      ++inside;
-      EXPECT_LT((f - f_without).norm(), 1e-6 * (1.0 + f_without.norm())) << "sample " << n;
-      continue;
-    }
-    ++outside;
-    const double shortfall = worst_miss(f_without);
-    const double miss = worst_miss(f);
-    for (int corner = 0; corner < 64; ++corner) {
-      Vector6d v;
-      for (int i = 0; i < kNumLegs; ++i) {
-        v(i) = (corner >> i & 1) ? weak.force_limit_n : -weak.force_limit_n;
-      }
-      EXPECT_LE(miss, worst_miss(v) + 1.01 * kRelaxationRelTol * shortfall + 1e-9 * shortfall)
-          << "sample " << n << " corner " << corner;
-    }
-  }
+  ForEachInfeasibleStep(
+      filter, 4000,
+      [&](int n, const FilterInput& x, const Vector6d& f, const SafetyDiagnostics& d) {
+        const Matrix6d map = filter.MetricMap(x.terms);
+        UncomposedQp qp;
+        UncomposedQpRows rows;
+        filter.BuildUncomposedQp(x.terms, x.qd, map, d.barriers, d.f_nominal, &qp, &rows);
+        const auto slack = [&](int row, const Vector6d& force) {
+          return qp.a.row(row).dot(map.partialPivLu().solve(force)) - qp.b(row);
+        };
+        const auto worst_miss = [&](const Vector6d& force) {
+          double miss = 0.0;
+          for (int i = 0; i < filter.constraints().num_velocity; ++i) {
+            const int row = rows.velocity_row[static_cast<size_t>(i)];
+            if (row >= 0) miss = std::fmax(miss, -slack(row, force));
+          }
+          return miss;
+        };
+        const auto is_velocity_row = [&](int r) {
+          for (int i = 0; i < filter.constraints().num_velocity; ++i) {
+            if (rows.velocity_row[static_cast<size_t>(i)] == r) return true;
+          }
+          return false;
+        };
+        const Vector6d f_without = ForceWithoutRows(qp, map, is_velocity_row);
+        if (!d.barriers.outside_position_set) {
+          ++inside;
+          EXPECT_LT((f - f_without).norm(), 1e-6 * (1.0 + f_without.norm())) << "sample " << n;
+          return;
+        }
+        ++outside;
+        const double shortfall = worst_miss(f_without);
+        const double miss = worst_miss(f);
+        for (int corner = 0; corner < 64; ++corner) {
+          const Vector6d v = BoxVertex(corner, kWeakForceLimitN);
+          EXPECT_LE(miss, worst_miss(v) + 1.01 * kRelaxationRelTol * shortfall + 1e-9 * shortfall)
+              << "sample " << n << " corner " << corner;
+        }
+      });
   EXPECT_GT(outside, 50);
   EXPECT_GT(inside, 50);
   std::printf(

@@ -20,6 +20,7 @@
 #include "stewart/safety/constraint_set.h"
 #include "stewart/safety/diagnostics.h"
 #include "stewart/safety/filter_workspace.h"
+#include "stewart/safety/least_relaxation.h"
 #include "stewart/safety/reference_qp.h"
 #include "stewart/safety/safety_config.h"
 #include "stewart/safety/uncomposed_qp.h"
@@ -48,13 +49,6 @@ constexpr double kReferenceActiveRelTol = 1e-10;
 /// broken. Far above the rounding of the composed solve, far below any
 /// physical margin.
 constexpr double kPerBarrierRelTol = 1e-9;
-
-/// An infeasible force-limited step relaxes the velocity condition by the
-/// least amount the position condition and the force limits allow, found by
-/// bisection to this fraction of the shortfall of the answer without it, in
-/// at most kMaxRelaxationSteps QP solves (SafetyFilter::RelaxVelocityLeast).
-constexpr double kRelaxationRelTol = 1e-3;
-constexpr int kMaxRelaxationSteps = 12;
 
 class SafetyFilter {
  public:
