@@ -418,7 +418,9 @@ bool SafetyFilter::ComputeMetricMap(const DynamicsTerms& terms, const BarrierInt
     map->setConstant(NAN);
     return false;
   }
-  *l_m = x.inertia.MatrixL();
+  // T = H^-1 L with M = L_M L_M^T (kinetic metric) or L = M (task
+  // accelerations): F = T y, cost ||y - y0||^2 = ||L^-1 H dF||^2.
+  *l_m = metric_ == CorrectionMetric::kTaskAcceleration ? terms.M : x.inertia.MatrixL();
   if (AccelerationMetricMap(terms.H, *l_m, factor, map)) return true;
   workspace_.leg_jacobian_degenerate = true;
   return false;
@@ -481,6 +483,11 @@ void SafetyFilter::SolveUnlimited(const StepInput& in, const FilterWorkspace& ws
     gram.pp = b.g_p.squaredNorm();
     gram.vv = b.g_v.squaredNorm();
     gram.pv = b.g_p.dot(b.g_v);
+  } else if (metric_ == CorrectionMetric::kTaskAcceleration) {
+    // T = H^-1 M: g~_p = -s_p M qd, g~_v = a_c.
+    gram.pp = x.s_p * x.s_p * x.m_qd.squaredNorm();
+    gram.vv = x.a_c.squaredNorm();
+    gram.pv = -x.s_p * x.m_qd.dot(x.a_c);
   } else {
     gram.pp = x.s_p * x.s_p * x.qd_m_qd;
     gram.vv = x.a_c.dot(x.m_inv_a_c);
@@ -503,6 +510,8 @@ void SafetyFilter::SolveUnlimited(const StepInput& in, const FilterWorkspace& ws
     // F* - F_des = W^-1 (mu_p g_p + mu_v g_v) with W^-1 = H^-1 M H^-T:
     // H (F* - F_des) = mu_v a_c - mu_p s_p M qd, one solve with H.
     Vector6d correction = s.mu_v * x.a_c - (s.mu_p * x.s_p) * x.m_qd;
+    // Task accelerations: W^-1 = H^-1 M^2 H^-T, H dF = M (mu_v a_c - mu_p s_p M qd).
+    if (metric_ == CorrectionMetric::kTaskAcceleration) correction = in.terms.M * correction;
     if (!SolveWithLegJacobian(in.terms.H, &workspace_.leg_jacobian, &correction)) {
       correction.setConstant(NAN);  // the fallback
       workspace_.leg_jacobian_degenerate = true;
@@ -533,6 +542,7 @@ Vector6d SafetyFilter::MetricCoordinates(const Vector6d& f, const Matrix6d& h,
                                          const BarrierIntermediates& x) const {
   if (metric_ == CorrectionMetric::kForce) return f;
   if (!x.inertia_valid) return Vector6d::Constant(NAN);
+  if (metric_ == CorrectionMetric::kTaskAcceleration) return x.inertia.Solve<1>(h * f);
   // T = H^-1 L_M (M = L_M L_M^T): T^-1 f = L_M^-1 H f, a product and a
   // triangular solve instead of a factorisation of T.
   return x.inertia.SolveFactorL(h * f);

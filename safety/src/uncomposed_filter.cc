@@ -78,7 +78,9 @@ bool SafetyFilter::PoseUncomposedQp(const StepInput& in, ConditionGroups groups,
   // triangular solves instead of solves with T and 6x6 products.
   Matrix6d l_m;
   if (!force_metric) {
-    l_m = ws.inertia_factor_l_ready ? ws.inertia_factor_l : ws.barrier.inertia.MatrixL();
+    l_m = ws.inertia_factor_l_ready                        ? ws.inertia_factor_l
+          : metric_ == CorrectionMetric::kTaskAcceleration ? terms.M
+                                                           : ws.barrier.inertia.MatrixL();
   }
   qp.x0 = ws.y_des_ready && ws.y_des_of_n == in.f_des
               ? ws.y_des
@@ -131,6 +133,8 @@ bool SafetyFilter::PoseUncomposedQp(const StepInput& in, ConditionGroups groups,
       Rhs6<6> m_inv = Rhs6<6>::Identity();
       ws.barrier.inertia.SolveInPlace<6>(&m_inv);
       g = terms.H.transpose() * m_inv;
+    } else if (metric_ == CorrectionMetric::kTaskAcceleration) {
+      g.setIdentity();  // T^T H^T M^-1 = M M^-1
     } else {
       // L_M^-1, lower triangular, column by column (forward substitution).
       const Vector6d inv_diag = l_m.diagonal().cwiseInverse();

@@ -28,18 +28,30 @@ ClosedLoopSummary RunTilted(const StackConfig& config) {
 }
 
 TEST(P16pJointTilt, TheAccelerometerBiasTakesTheTiltAndTheLegsPinTheVelocity) {
-  StackConfig without_config = DcMotorStackConfig();
-  ASSERT_GT(without_config.estimator.initial_accel_bias_std_mps2, 0.0)
-      << "the P-16P overlay estimates the accelerometer's bias";
-  without_config.estimator.initial_accel_bias_std_mps2 = 0.0;
-  const test::WithoutAndWith r =
-      test::ExpectHoldsOnlyWith(without_config, DcMotorStackConfig(), RunTilted);
-  // The velocity estimate follows the truth (0.4 against 2.3 mm/s rms when
-  // measured), and the platform no longer stalls near x = 0.1 m on a
-  // phantom velocity: the tracking is the exact model's (35 mm).
-  EXPECT_LT(r.with.rms_qd_error, 0.5 * r.without.rms_qd_error);
-  EXPECT_LT(r.with.rms_translation_tracking_inside_m,
-            0.75 * r.without.rms_translation_tracking_inside_m);
+  // In the overlay's metric (the rotors' kinetic energy), with which this run
+  // was measured, and in the task-acceleration metric.
+  for (const CorrectionMetric metric :
+       {CorrectionMetric::kTaskAcceleration, CorrectionMetric::kAcceleration}) {
+    StackConfig with_config = DcMotorStackConfig();
+    with_config.safety.correction_metric = metric;
+    StackConfig without_config = with_config;
+    ASSERT_GT(without_config.estimator.initial_accel_bias_std_mps2, 0.0)
+        << "the P-16P overlay estimates the accelerometer's bias";
+    without_config.estimator.initial_accel_bias_std_mps2 = 0.0;
+    std::printf("[p16p joint tilt] correction metric %s\n", ToString(metric).c_str());
+    const test::WithoutAndWith r =
+        test::ExpectHoldsOnlyWith(without_config, with_config, RunTilted);
+    // The velocity estimate follows the truth (0.4 against 2.3-3.0 mm/s rms
+    // when measured).
+    EXPECT_LT(r.with.rms_qd_error, 0.5 * r.without.rms_qd_error);
+    if (metric == CorrectionMetric::kAcceleration) {
+      // In the kinetic metric the platform stalled near x = 0.1 m on the
+      // phantom velocity (tracking 66 against 35 mm when measured); in the
+      // task metric it does not (36.7 against 32.2 mm).
+      EXPECT_LT(r.with.rms_translation_tracking_inside_m,
+                0.75 * r.without.rms_translation_tracking_inside_m);
+    }
+  }
 }
 
 }  // namespace

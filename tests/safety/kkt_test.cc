@@ -33,9 +33,18 @@ void CheckKkt(bool force_limits, CorrectionMetric metric) {
     if (metric == CorrectionMetric::kForce) {
       EXPECT_EQ(t, Matrix6d::Identity());
     } else {
-      // T T^T is W^-1 = (H^T M^-1 H)^-1.
-      const Matrix6d w = terms.H.transpose() * terms.M.inverse() * terms.H;
-      EXPECT_LE((t * t.transpose() * w - Matrix6d::Identity()).norm(), 1e-8) << "sample " << n;
+      // T T^T is W^-1: W = H^T M^-1 H (kinetic energy) or H^T M^-2 H (task
+      // accelerations).
+      const Matrix6d m_inv = terms.M.inverse();
+      const Matrix6d w = metric == CorrectionMetric::kAcceleration
+                             ? Matrix6d(terms.H.transpose() * m_inv * terms.H)
+                             : Matrix6d(terms.H.transpose() * m_inv * m_inv * terms.H);
+      // M^-2 spans the platform's mass and rotational inertia squared
+      // (~1e5 between its entries): rounding relative to the factors' size.
+      const double tolerance = metric == CorrectionMetric::kAcceleration
+                                   ? 1e-8
+                                   : 1e-8 * w.norm() * (t * t.transpose()).norm();
+      EXPECT_LE((t * t.transpose() * w - Matrix6d::Identity()).norm(), tolerance) << "sample " << n;
     }
     const Vector6d residual =
         f - f_des - t * t.transpose() * (d.mu_p * b.g_p + d.mu_v * b.g_v - d.mu_force);
@@ -62,6 +71,12 @@ TEST(Kkt, ClosedForm) { CheckKkt(false, CorrectionMetric::kForce); }
 TEST(Kkt, ForceLimited) { CheckKkt(true, CorrectionMetric::kForce); }
 TEST(Kkt, ClosedFormAccelerationMetric) { CheckKkt(false, CorrectionMetric::kAcceleration); }
 TEST(Kkt, ForceLimitedAccelerationMetric) { CheckKkt(true, CorrectionMetric::kAcceleration); }
+TEST(Kkt, ClosedFormTaskAccelerationMetric) {
+  CheckKkt(false, CorrectionMetric::kTaskAcceleration);
+}
+TEST(Kkt, ForceLimitedTaskAccelerationMetric) {
+  CheckKkt(true, CorrectionMetric::kTaskAcceleration);
+}
 
 }  // namespace
 }  // namespace stewart::safety::test

@@ -68,8 +68,10 @@ void Sweep(ReferenceQpSolver* reference, bool force_limits, CorrectionMetric met
       "%s%s%s: worst rel err %.3g; cases none %d pos %d vel %d both %d infeasible %d; "
       "paper rule differs from QP in %d\n",
       reference->name(), force_limits ? " (force limits)" : "",
-      metric == CorrectionMetric::kForce ? " (force metric)" : " (acceleration metric)", worst,
-      cases[0], cases[1], cases[2], cases[3], cases[4], paper_differs);
+      metric == CorrectionMetric::kForce          ? " (force metric)"
+      : metric == CorrectionMetric::kAcceleration ? " (acceleration metric)"
+                                                  : " (task acceleration metric)",
+      worst, cases[0], cases[1], cases[2], cases[3], cases[4], paper_differs);
   // The sweep must exercise every feasible case, or it proves little.
   EXPECT_GT(cases[0], samples / 100);
   EXPECT_GT(cases[1], samples / 100);
@@ -83,6 +85,7 @@ void Sweep(ReferenceQpSolver* reference, bool force_limits, CorrectionMetric met
 
 constexpr CorrectionMetric kForceMetric = CorrectionMetric::kForce;
 constexpr CorrectionMetric kAccelMetric = CorrectionMetric::kAcceleration;
+constexpr CorrectionMetric kTaskMetric = CorrectionMetric::kTaskAcceleration;
 
 TEST(ReferenceSweep, ClosedFormEqualsClp) {
   ClpReferenceQp clp;
@@ -111,6 +114,12 @@ TEST(ReferenceSweep, ForceLimitedEqualsAlglib) {
   AlglibReferenceQp alglib;
   Sweep(&alglib, true, kForceMetric, kSamples / 4);
   Sweep(&alglib, true, kAccelMetric, kSamples / 4);
+}
+
+TEST(ReferenceSweep, TaskAccelerationMetricEqualsAlglib) {
+  AlglibReferenceQp alglib;
+  Sweep(&alglib, false, kTaskMetric, kSamples);
+  Sweep(&alglib, true, kTaskMetric, kSamples / 4);
 }
 #endif
 

@@ -154,6 +154,7 @@ void Sweep(bool force_limits, CorrectionMetric metric, int samples, Draw draw,
 
 constexpr CorrectionMetric kForceMetric = CorrectionMetric::kForce;
 constexpr CorrectionMetric kAccelMetric = CorrectionMetric::kAcceleration;
+constexpr CorrectionMetric kTaskMetric = CorrectionMetric::kTaskAcceleration;
 
 #ifdef STEWART_HAVE_ALGLIB
 void SweepAgainstAlglib(bool force_limits, Draw draw, int samples) {
@@ -161,7 +162,7 @@ void SweepAgainstAlglib(bool force_limits, Draw draw, int samples) {
   const Reference reference = [&](const UncomposedQp& qp, Vector6d* y) {
     return alglib.Solve(qp, y);
   };
-  for (const CorrectionMetric metric : {kForceMetric, kAccelMetric}) {
+  for (const CorrectionMetric metric : {kForceMetric, kAccelMetric, kTaskMetric}) {
     SweepCounts counts;
     Sweep(force_limits, metric, samples, draw, "alglib", reference, &counts);
     const std::array<int, 6>& c = counts.cases;

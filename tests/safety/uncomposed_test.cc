@@ -138,7 +138,13 @@ TEST(Uncomposed, KktForceMetric) { CheckKkt(false, CorrectionMetric::kForce, 0.0
 TEST(Uncomposed, KktAccelerationMetric) {
   CheckKkt(false, CorrectionMetric::kAcceleration, 0.0, 0.0);
 }
+TEST(Uncomposed, KktTaskAccelerationMetric) {
+  CheckKkt(false, CorrectionMetric::kTaskAcceleration, 0.0, 0.0);
+}
 TEST(Uncomposed, KktForceLimited) { CheckKkt(true, CorrectionMetric::kForce, 0.0, 0.0); }
+TEST(Uncomposed, KktForceLimitedTaskAccelerationMetric) {
+  CheckKkt(true, CorrectionMetric::kTaskAcceleration, 0.0, 0.0);
+}
 TEST(Uncomposed, KktForceLimitedAccelerationMetric) {
   CheckKkt(true, CorrectionMetric::kAcceleration, 0.0, 0.0);
 }

@@ -100,6 +100,15 @@ TEST(DiagnosticsMessage, CarriesEveryFilterQuantity) {
   EXPECT_GE(msg.psi_v + g_v.dot(f_safe - f_des), -1e-12);
 }
 
+// Every metric has its own METRIC_* value (a reader recomputing F* needs it).
+TEST(DiagnosticsMessage, NamesEveryCorrectionMetric) {
+  EXPECT_EQ(ToLcmMetric(CorrectionMetric::kForce), +safety_diagnostics_t::METRIC_FORCE);
+  EXPECT_EQ(ToLcmMetric(CorrectionMetric::kAcceleration),
+            +safety_diagnostics_t::METRIC_ACCELERATION);
+  EXPECT_EQ(ToLcmMetric(CorrectionMetric::kTaskAcceleration),
+            +safety_diagnostics_t::METRIC_TASK_ACCELERATION);
+}
+
 TEST(DiagnosticsMessage, UncomposedCarriesEachBarriersMultiplier) {
   SafetyConfig config = DefaultStackConfig().safety;
   config.variant = SafetyVariant::kUncomposed;

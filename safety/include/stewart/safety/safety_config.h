@@ -55,10 +55,13 @@ inline constexpr EnumTable<SafetyFallback, 2> kSafetyFallbackNames{{{
 ///   kForce:        ||F - F_des||^2                   (the paper's QP)
 ///   kAcceleration: (qdd - qdd_des)^T M (qdd - qdd_des)
 ///                  = (F - F_des)^T H^T M^-1 H (F - F_des)   (Gauss's least constraint)
-enum class CorrectionMetric { kForce, kAcceleration };
-inline constexpr EnumTable<CorrectionMetric, 2> kCorrectionMetricNames{{{
+///   kTaskAcceleration: ||qdd - qdd_des||^2
+///                  = (F - F_des)^T H^T M^-2 H (F - F_des)
+enum class CorrectionMetric { kForce, kAcceleration, kTaskAcceleration };
+inline constexpr EnumTable<CorrectionMetric, 3> kCorrectionMetricNames{{{
     {CorrectionMetric::kForce, "force"},
     {CorrectionMetric::kAcceleration, "acceleration"},
+    {CorrectionMetric::kTaskAcceleration, "task_acceleration"},
 }}};
 
 /// `safety`: the CBF filter's constraints and parameters.

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstddef>
 #include <string>
 #include <utility>
 #include <vector>
@@ -26,12 +27,27 @@ inline constexpr std::array<std::pair<SafetyVariant, std::int8_t>, kSafetyVarian
         {SafetyVariant::kUncomposed, safety_diagnostics_t::VARIANT_UNCOMPOSED},
     }};
 
-inline std::int8_t ToLcmVariant(SafetyVariant v) {
-  for (const auto& [variant, value] : kLcmVariants) {
-    if (variant == v) return value;
+/// The value `table` gives `e`; its first entry's for one it lacks.
+template <typename Enum, std::size_t N>
+std::int8_t LcmValueOf(const std::array<std::pair<Enum, std::int8_t>, N>& table, Enum e) {
+  for (const auto& [key, value] : table) {
+    if (key == e) return value;
   }
-  return safety_diagnostics_t::VARIANT_CLOSED_FORM;
+  return table[0].second;
 }
+
+inline std::int8_t ToLcmVariant(SafetyVariant v) { return LcmValueOf(kLcmVariants, v); }
+
+/// Every correction metric and its safety_diagnostics_t::METRIC_* value, in
+/// the order of kCorrectionMetricNames.
+inline constexpr std::array<std::pair<CorrectionMetric, std::int8_t>, kCorrectionMetricNames.size()>
+    kLcmMetrics{{
+        {CorrectionMetric::kForce, safety_diagnostics_t::METRIC_FORCE},
+        {CorrectionMetric::kAcceleration, safety_diagnostics_t::METRIC_ACCELERATION},
+        {CorrectionMetric::kTaskAcceleration, safety_diagnostics_t::METRIC_TASK_ACCELERATION},
+    }};
+
+inline std::int8_t ToLcmMetric(CorrectionMetric m) { return LcmValueOf(kLcmMetrics, m); }
 
 /// The variant of a recorded VARIANT_* value; closed form for an unknown one.
 inline SafetyVariant FromLcmVariant(std::int8_t value) {
@@ -88,9 +104,7 @@ inline void FillDiagnosticsMessage(const SafetyFilter& filter, const SafetyDiagn
   const ConstraintSet& c = filter.constraints();
   const BarrierEvaluation& b = d.barriers;
   msg->variant = ToLcmVariant(d.variant);
-  msg->correction_metric = filter.correction_metric() == CorrectionMetric::kAcceleration
-                               ? safety_diagnostics_t::METRIC_ACCELERATION
-                               : safety_diagnostics_t::METRIC_FORCE;
+  msg->correction_metric = ToLcmMetric(filter.correction_metric());
   msg->active_case = static_cast<std::int8_t>(d.filter_case);
   msg->infeasible = d.infeasible;
   msg->fallback_reason = d.flags & (kFlagInfeasible | kFlagFallback | kFlagInvalidInput);
