@@ -1,7 +1,9 @@
 #pragma once
-// QP reference with COIN-OR Clp (EPL-2.0): the quadratic objective goes to
-// ClpSimplex::loadQuadraticObjective and is solved by Clp's primal simplex
-// for QPs (docs/safety.md: accuracy and speed measured against ALGLIB).
+// QP reference with COIN-OR Clp (EPL-2.0): Clp's interior point (barrier) on
+// the QP finds the active set; the answer is the exact projection on that
+// set, returned only when the KKT conditions certify it. Clp's dual simplex
+// on the rows decides infeasibility when no certified answer comes out
+// (docs/safety.md "QP reference: ALGLIB vs Clp": why not its QP simplex).
 #include "stewart/safety/reference_qp.h"
 
 namespace stewart::safety {
