@@ -169,7 +169,7 @@ Vector6d SafetyFilter::StepWithTerms(const DynamicsTerms& terms, const Vector6d&
   d->compute_ns = 0;
   workspace_.leg_jacobian_degenerate = false;
   workspace_.leg_jacobian.Reset();
-  workspace_.inertia_factor_l_ready = false;
+  workspace_.metric_factor_ready = false;
   workspace_.y_des_ready = false;
 
   // A finite pose the platform cannot be in (pose_plausibility.h) is as
@@ -402,14 +402,21 @@ Matrix6d SafetyFilter::MetricMap(const DynamicsTerms& terms) const {
 }
 
 bool SafetyFilter::ComputeStepMetricMap(const DynamicsTerms& terms, FilterWorkspace* ws) const {
-  const bool ok = ComputeMetricMap(terms, ws->barrier, &ws->leg_jacobian, &ws->inertia_factor_l,
-                                   &ws->metric_map);
-  ws->inertia_factor_l_ready = ok && metric_ != CorrectionMetric::kForce;
+  const bool ok =
+      ComputeMetricMap(terms, ws->barrier, &ws->leg_jacobian, &ws->metric_factor, &ws->metric_map);
+  ws->metric_factor_ready = ok && metric_ != CorrectionMetric::kForce;
   return ok;
 }
 
+Matrix6d SafetyFilter::MetricFactor(const DynamicsTerms& terms,
+                                    const BarrierIntermediates& x) const {
+  // T = H^-1 L: F = T y, cost ||y - y0||^2 = ||L^-1 H dF||^2, which is
+  // dqdd^T M dqdd for L = L_M and ||dqdd||^2 for L = M (dqdd = M^-1 H dF).
+  return metric_ == CorrectionMetric::kTaskAcceleration ? terms.M : x.inertia.MatrixL();
+}
+
 bool SafetyFilter::ComputeMetricMap(const DynamicsTerms& terms, const BarrierIntermediates& x,
-                                    LegJacobianFactor* factor, Matrix6d* l_m, Matrix6d* map) const {
+                                    LegJacobianFactor* factor, Matrix6d* l, Matrix6d* map) const {
   if (metric_ == CorrectionMetric::kForce) {
     map->setIdentity();
     return true;
@@ -418,10 +425,8 @@ bool SafetyFilter::ComputeMetricMap(const DynamicsTerms& terms, const BarrierInt
     map->setConstant(NAN);
     return false;
   }
-  // T = H^-1 L with M = L_M L_M^T (kinetic metric) or L = M (task
-  // accelerations): F = T y, cost ||y - y0||^2 = ||L^-1 H dF||^2.
-  *l_m = metric_ == CorrectionMetric::kTaskAcceleration ? terms.M : x.inertia.MatrixL();
-  if (AccelerationMetricMap(terms.H, *l_m, factor, map)) return true;
+  *l = MetricFactor(terms, x);
+  if (AccelerationMetricMap(terms.H, *l, factor, map)) return true;
   workspace_.leg_jacobian_degenerate = true;
   return false;
 }

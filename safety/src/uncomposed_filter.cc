@@ -70,17 +70,17 @@ bool SafetyFilter::PoseUncomposedQp(const StepInput& in, ConditionGroups groups,
   const ConstraintSet& c = constraints_;
   const bool force_metric = metric_ == CorrectionMetric::kForce;
   qp.m = 0;
-  // The acceleration metric's map is T = H^-1 L_M (M = L_M L_M^T), so in
-  // y = T^-1 F every normal and y0 need L_M alone, not T:
-  //   y0 = T^-1 F_des = L_M^-1 H F_des,
-  //   T^T (-H^T qd) = -L_M^T qd                 (position rows),
-  //   T^T H^T M^-1 e_j = L_M^T M^-1 e_j = L_M^-1 e_j   (velocity rows),
-  // triangular solves instead of solves with T and 6x6 products.
-  Matrix6d l_m;
+  // The map is T = H^-1 L (MetricFactor: L_M with M = L_M L_M^T for the
+  // kinetic metric, M for task accelerations), so in y = T^-1 F every normal
+  // and y0 need L alone, not T:
+  //   y0 = T^-1 F_des = L^-1 H F_des,
+  //   T^T (-H^T qd) = -L^T qd                          (position rows),
+  //   T^T H^T M^-1 e_j = L^T M^-1 e_j                  (velocity rows:
+  //     L_M^-1 e_j, a triangular solve; e_j itself for L = M),
+  // instead of solves with T and 6x6 products.
+  Matrix6d metric_l;
   if (!force_metric) {
-    l_m = ws.inertia_factor_l_ready                        ? ws.inertia_factor_l
-          : metric_ == CorrectionMetric::kTaskAcceleration ? terms.M
-                                                           : ws.barrier.inertia.MatrixL();
+    metric_l = ws.metric_factor_ready ? ws.metric_factor : MetricFactor(terms, ws.barrier);
   }
   qp.x0 = ws.y_des_ready && ws.y_des_of_n == in.f_des
               ? ws.y_des
@@ -94,7 +94,7 @@ bool SafetyFilter::PoseUncomposedQp(const StepInput& in, ConditionGroups groups,
     // (it implies the others), so that one alone is posed: the feasible set,
     // hence the optimum, is the same, and the others' multipliers are 0.
     const Vector6d g = force_metric ? Vector6d(-(terms.H.transpose() * in.qd))
-                                    : Vector6d(-(l_m.transpose() * in.qd));
+                                    : Vector6d(-(metric_l.transpose() * in.qd));
     const double g_norm = g.norm();
     const double g_dot_x0 = g.dot(qp.x0);
     int best = -1;
@@ -137,13 +137,13 @@ bool SafetyFilter::PoseUncomposedQp(const StepInput& in, ConditionGroups groups,
       g.setIdentity();  // T^T H^T M^-1 = M M^-1
     } else {
       // L_M^-1, lower triangular, column by column (forward substitution).
-      const Vector6d inv_diag = l_m.diagonal().cwiseInverse();
+      const Vector6d inv_diag = metric_l.diagonal().cwiseInverse();
       g.setZero();
       for (int j = 0; j < 6; ++j) {
         g(j, j) = inv_diag(j);
         for (int i = j + 1; i < 6; ++i) {
           double sum = 0.0;
-          for (int k = j; k < i; ++k) sum += l_m(i, k) * g(k, j);
+          for (int k = j; k < i; ++k) sum += metric_l(i, k) * g(k, j);
           g(i, j) = -sum * inv_diag(i);
         }
       }

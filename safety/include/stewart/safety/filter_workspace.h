@@ -49,9 +49,10 @@ struct alignas(64) FilterWorkspace {
       velocity_alone;  ///< its unlimited fallback: the velocity rows, from the position rows'
                        ///< point; its force-limited one: every row, relaxed
   LegJacobianFactor leg_jacobian;  ///< reset by each step
-  /// L_M (M = L_M L_M^T) as the metric map's computation left it this step.
-  Matrix6d inertia_factor_l;
-  bool inertia_factor_l_ready = false;  ///< reset by each step
+  /// The metric's factor L (T = H^-1 L; SafetyFilter::MetricFactor) as the
+  /// metric map's computation left it this step.
+  Matrix6d metric_factor;
+  bool metric_factor_ready = false;  ///< reset by each step
   /// y = T^-1 F of the force-limited posing, for F = y_des_of_n.
   Vector6d y_des, y_des_of_n;
   bool y_des_ready = false;  ///< reset by each step

@@ -198,12 +198,16 @@ class SafetyFilter {
                     const Vector6d& disturbance_n) const;
   /// The safe stop as the answer of a step whose QP has no solution.
   void ApplySafeStop(const StepInput& in, SafetyDiagnostics* d) const;
-  /// The step's T, L_M and H factor in `ws` (ComputeMetricMap), and the flag
-  /// that lets the un-composed posing reuse that L_M.
+  /// The step's T, L and H factor in `ws` (ComputeMetricMap), and the flag
+  /// that lets the un-composed posing reuse that L.
   bool ComputeStepMetricMap(const DynamicsTerms& terms, FilterWorkspace* ws) const;
-  /// T into `map` (and L_M into `l_m` with the acceleration metric).
+  /// The factor L of the metric's map T = H^-1 L (not the force metric's):
+  /// L_M with M = L_M L_M^T for the kinetic metric (acceleration), M itself
+  /// for task accelerations. Needs x.inertia_valid for the kinetic metric.
+  Matrix6d MetricFactor(const DynamicsTerms& terms, const BarrierIntermediates& x) const;
+  /// T into `map` (and its factor L into `l`, except for the force metric).
   bool ComputeMetricMap(const DynamicsTerms& terms, const BarrierIntermediates& x,
-                        LegJacobianFactor* factor, Matrix6d* l_m, Matrix6d* map) const;
+                        LegJacobianFactor* factor, Matrix6d* l, Matrix6d* map) const;
   void SolveUnlimited(const StepInput& in, const FilterWorkspace& ws, SafetyDiagnostics* d) const;
   /// ws->problem from the barriers and ws->metric_map.
   void ComposeProblem(const BarrierEvaluation& b, FilterWorkspace* ws) const;
