@@ -1,4 +1,4 @@
-// Variant uncomposed == ALGLIB's dense QP on the exact QP the filter poses
+// Variant uncomposed == ALGLIB's dense QP and Clp on the exact QP the filter poses
 // (SafetyFilter::BuildUncomposedQp: every barrier a row, up to 48 rows; ctest
 // label `long`): random states and nominal forces (reference_sweep_test.cc's),
 // and states near a position limit (uncomposed_support.h), where position rows
@@ -7,16 +7,17 @@
 // solver and the fallbacks' "infeasible" verdicts, 1e-9 relative as in
 // reference_sweep_test.cc.
 //
-// Clp cannot be the reference here (docs/safety.md): its QP simplex loops
-// forever or returns infeasible "optima" on this QP, posed as the primal or
-// as its bound-constrained dual. So this test needs the optional GPL
-// component and is skipped without it.
+// Clp's QP simplex looped forever or returned infeasible "optima" on this QP
+// (docs/safety.md); ClpReferenceQp asks its barrier for the active set and
+// certifies the projection on it, which serves here too, so these sweeps
+// run without the optional GPL component (its own sweeps are skipped then).
 #include <gtest/gtest.h>
 
 #include <array>
 #include <cmath>
 #include <functional>
 
+#include "stewart/safety/clp_reference_qp.h"
 #include "uncomposed_support.h"
 #ifdef STEWART_HAVE_ALGLIB
 #include "stewart/safety/alglib_reference_qp.h"
@@ -156,15 +157,11 @@ constexpr CorrectionMetric kForceMetric = CorrectionMetric::kForce;
 constexpr CorrectionMetric kAccelMetric = CorrectionMetric::kAcceleration;
 constexpr CorrectionMetric kTaskMetric = CorrectionMetric::kTaskAcceleration;
 
-#ifdef STEWART_HAVE_ALGLIB
-void SweepAgainstAlglib(bool force_limits, Draw draw, int samples) {
-  AlglibReferenceQp alglib;
-  const Reference reference = [&](const UncomposedQp& qp, Vector6d* y) {
-    return alglib.Solve(qp, y);
-  };
+void SweepAgainst(const char* name, const Reference& reference, bool force_limits, Draw draw,
+                  int samples) {
   for (const CorrectionMetric metric : {kForceMetric, kAccelMetric, kTaskMetric}) {
     SweepCounts counts;
-    Sweep(force_limits, metric, samples, draw, "alglib", reference, &counts);
+    Sweep(force_limits, metric, samples, draw, name, reference, &counts);
     const std::array<int, 6>& c = counts.cases;
     if (draw == Draw::kRandom) {
       EXPECT_GT(c[0], samples / 100) << "none";
@@ -178,6 +175,21 @@ void SweepAgainstAlglib(bool force_limits, Draw draw, int samples) {
       EXPECT_GT(c[3], samples / 20) << "both";
     }
   }
+}
+
+void SweepAgainstClp(bool force_limits, Draw draw, int samples) {
+  ClpReferenceQp clp;
+  SweepAgainst(
+      "clp", [&](const UncomposedQp& qp, Vector6d* y) { return clp.Solve(qp, y); }, force_limits,
+      draw, samples);
+}
+
+#ifdef STEWART_HAVE_ALGLIB
+void SweepAgainstAlglib(bool force_limits, Draw draw, int samples) {
+  AlglibReferenceQp alglib;
+  SweepAgainst(
+      "alglib", [&](const UncomposedQp& qp, Vector6d* y) { return alglib.Solve(qp, y); },
+      force_limits, draw, samples);
 }
 #define STEWART_REQUIRE_ALGLIB()
 #else
@@ -205,6 +217,19 @@ TEST(UncomposedReferenceSweep, NearLimitsEqualAlglib) {
   SweepAgainstAlglib(false, Draw::kNearLimits, 6000);
   SweepAgainstAlglib(true, Draw::kNearLimits, 6000);
 #endif
+}
+
+TEST(UncomposedReferenceSweep, RandomStatesEqualClp) {
+  SweepAgainstClp(false, Draw::kRandom, 10000);
+}
+
+TEST(UncomposedReferenceSweep, ForceLimitedRandomStatesEqualClp) {
+  SweepAgainstClp(true, Draw::kRandom, 5000);
+}
+
+TEST(UncomposedReferenceSweep, NearLimitsEqualClp) {
+  SweepAgainstClp(false, Draw::kNearLimits, 3000);
+  SweepAgainstClp(true, Draw::kNearLimits, 3000);
 }
 
 }  // namespace

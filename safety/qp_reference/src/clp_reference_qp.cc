@@ -1,7 +1,6 @@
 #include "stewart/safety/clp_reference_qp.h"
 
 #include <ClpSimplex.hpp>
-#include <ClpSolve.hpp>
 #include <CoinPackedMatrix.hpp>
 #include <Eigen/Dense>
 #include <algorithm>
@@ -14,10 +13,11 @@ namespace {
 // The QP in Clp's coordinates: d = x - x0, unit rows n_r^T d >= c_r. Clp's
 // tolerances are absolute, so the unshifted problem (|x0| up to ~1e3 in the
 // acceleration metric's coordinates) and unnormalized rows lose digits.
+template <int MaxRows>
 struct ShiftedQp {
   int m = 0;
-  Eigen::Matrix<double, kMaxQpRows, 6> n;
-  Eigen::Matrix<double, kMaxQpRows, 1> c;
+  Eigen::Matrix<double, MaxRows, 6> n;
+  Eigen::Matrix<double, MaxRows, 1> c;
 };
 
 // A slack below this (times the problem's scale) puts a row in the active
@@ -26,8 +26,11 @@ constexpr double kBarrierActiveSlack = 1e-6;
 // KKT certificate, relative to the problem's scale: rows violated by no more,
 // multipliers no more negative.
 constexpr double kCertificateTol = 1e-11;
+// Interior-point iterations before the barrier gives up (it takes ~10-40).
+constexpr int kMaxBarrierIterations = 200;
 
-double Scale(const ShiftedQp& qp, const Vector6d& d) {
+template <int MaxRows>
+double Scale(const ShiftedQp<MaxRows>& qp, const Vector6d& d) {
   double scale = std::max(1.0, d.norm());
   for (int r = 0; r < qp.m; ++r) scale = std::max(scale, std::abs(qp.c(r)));
   return scale;
@@ -37,15 +40,18 @@ double Scale(const ShiftedQp& qp, const Vector6d& d) {
 // multipliers (d = sum lambda_r n_r). Rows with the same unit normal are one
 // row (the more restrictive), so the active normals stay independent unless
 // the set is degenerate, which the certificate then rejects.
+template <int MaxRows>
 struct Polished {
   Vector6d d = Vector6d::Zero();
-  Eigen::Matrix<double, kMaxQpRows, 1> lambda = Eigen::Matrix<double, kMaxQpRows, 1>::Zero();
+  Eigen::Matrix<double, MaxRows, 1> lambda = Eigen::Matrix<double, MaxRows, 1>::Zero();
   bool solved = false;
 };
 
-Polished PolishOnActiveSet(const ShiftedQp& qp, const std::array<bool, kMaxQpRows>& active) {
-  Polished out;
-  std::array<int, kMaxQpRows> rows{};
+template <int MaxRows>
+Polished<MaxRows> PolishOnActiveSet(const ShiftedQp<MaxRows>& qp,
+                                    const std::array<bool, MaxRows>& active) {
+  Polished<MaxRows> out;
+  std::array<int, MaxRows> rows{};
   int k = 0;
   for (int r = 0; r < qp.m; ++r) {
     if (!active[static_cast<size_t>(r)]) continue;
@@ -83,10 +89,9 @@ Polished PolishOnActiveSet(const ShiftedQp& qp, const std::array<bool, kMaxQpRow
   return out;
 }
 
-}  // namespace
-
-ProjectionStatus ClpReferenceQp::Solve(const ProjectionQp& qp, Vector6d* x) {
-  ShiftedQp shifted;
+template <int MaxRows>
+ProjectionStatus SolveWithClp(const ProjectionQpN<MaxRows>& qp, Vector6d* x) {
+  ShiftedQp<MaxRows> shifted;
   shifted.m = qp.m;
   for (int r = 0; r < qp.m; ++r) {
     const double norm = qp.a.row(r).norm();
@@ -106,7 +111,7 @@ ProjectionStatus ClpReferenceQp::Solve(const ProjectionQp& qp, Vector6d* x) {
   col_upper.fill(COIN_DBL_MAX);
   CoinPackedMatrix matrix(false, 0, 0);
   matrix.setDimensions(0, 6);
-  std::array<double, kMaxQpRows> row_lower{}, row_upper{};
+  std::array<double, MaxRows> row_lower{}, row_upper{};
   const std::array<int, 6> index = {0, 1, 2, 3, 4, 5};
   for (int r = 0; r < qp.m; ++r) {
     std::array<double, 6> row{};
@@ -136,11 +141,15 @@ ProjectionStatus ClpReferenceQp::Solve(const ProjectionQp& qp, Vector6d* x) {
   const std::array<CoinBigIndex, 7> start = {0, 1, 2, 3, 4, 5, 6};
   const std::array<double, 6> diagonal = {1, 1, 1, 1, 1, 1};
   qp_model.loadQuadraticObjective(6, start.data(), index.data(), diagonal.data());
-  ClpSolve barrier;
-  barrier.setSolveType(ClpSolve::useBarrier);
-  barrier.setPresolveType(ClpSolve::presolveOff);
-  qp_model.initialSolve(barrier);
-  if (!qp_model.isProvenOptimal()) return verdict_without_answer();
+  // ClpSimplex::barrier directly, without crossover: through initialSolve
+  // some un-composed QPs left a status that trips an assertion there (an
+  // abort). Below 1000 the iteration limit is the barrier's own. Its status
+  // is not read: it called ~1.5 % of the un-composed sweeps' QPs not optimal
+  // whose point the certificate below then proved; what counts is whether
+  // its point leads to a certified answer.
+  qp_model.setMaximumIterations(kMaxBarrierIterations);
+  qp_model.barrier(false);
+  if (qp_model.primalColumnSolution() == nullptr) return verdict_without_answer();
 
   // The answer is the exact projection on that active set, certified by the
   // KKT conditions (feasible, multipliers >= 0: sufficient for this convex
@@ -150,13 +159,13 @@ ProjectionStatus ClpReferenceQp::Solve(const ProjectionQp& qp, Vector6d* x) {
   Vector6d d_barrier;
   for (int i = 0; i < 6; ++i) d_barrier(i) = qp_model.primalColumnSolution()[i];
   const double barrier_scale = Scale(shifted, d_barrier);
-  std::array<bool, kMaxQpRows> active{};
+  std::array<bool, MaxRows> active{};
   for (int r = 0; r < qp.m; ++r) {
     active[static_cast<size_t>(r)] =
         shifted.n.row(r).dot(d_barrier) - shifted.c(r) <= kBarrierActiveSlack * barrier_scale;
   }
   for (int attempt = 0; attempt <= 2 * qp.m; ++attempt) {
-    const Polished polished = PolishOnActiveSet(shifted, active);
+    const Polished<MaxRows> polished = PolishOnActiveSet<MaxRows>(shifted, active);
     if (!polished.solved) return verdict_without_answer();
     const double scale = Scale(shifted, polished.d);
     int most_violated = -1;
@@ -186,6 +195,16 @@ ProjectionStatus ClpReferenceQp::Solve(const ProjectionQp& qp, Vector6d* x) {
     }
   }
   return verdict_without_answer();
+}
+
+}  // namespace
+
+ProjectionStatus ClpReferenceQp::Solve(const ProjectionQp& qp, Vector6d* x) {
+  return SolveWithClp(qp, x);
+}
+
+ProjectionStatus ClpReferenceQp::Solve(const UncomposedQp& qp, Vector6d* x) {
+  return SolveWithClp(qp, x);
 }
 
 }  // namespace stewart::safety
