@@ -206,8 +206,8 @@ std::vector<std::string> CampaignColumns(const CampaignSpec& spec) {
   for (const char* name :
        {"tracking_rms_m", "estimate_rms_m", "estimate_rms_mps", "estimator_restarts",
         "estimator_rejections", "fallback_ticks", "infeasible_ticks", "nominal_bounded_ticks",
-        "per_barrier_ticks", "endstop_hits", "leg_stroke_margin_m", "stiff_fallbacks", "completed",
-        "failure", "wall_s"}) {
+        "per_barrier_ticks", "endstop_hits", "leg_stroke_margin_m", "stiff_fallbacks", "armed_s",
+        "completed", "failure", "wall_s"}) {
     columns.push_back(name);
   }
   return columns;
@@ -233,7 +233,8 @@ std::string CampaignCsvLine(const CampaignSpec& spec, const CampaignRow& row) {
        << ',' << s.fallback_ticks << ',' << s.infeasible_ticks << ',' << s.nominal_bounded_ticks
        << ',' << s.per_barrier_ticks << ',' << s.endstop_hits << ','
        << Number(s.leg_stroke_worst_margin_m) << ',' << s.stiff_fallbacks << ','
-       << (s.completed ? 1 : 0) << ',' << CsvField(s.failure) << ',' << Number(row.wall_s);
+       << Number(s.armed_s) << ',' << (s.completed ? 1 : 0) << ',' << CsvField(s.failure) << ','
+       << Number(row.wall_s);
   return line.str();
 }
 

@@ -271,6 +271,16 @@ json SummarizeCampaign(const CsvTable& runs, const json& meta, double tolerance)
   s["runs_with_endstop_hits"] = count_positive("endstop_hits");
   s["endstop_hits"] = total("endstop_hits");
   s["runs_with_stiff_fallbacks"] = count_positive("stiff_fallbacks");
+  // Runs whose supervisor never armed: their limits were the plant's with the
+  // drive off, not the stack's doing (a start the filter calls outside its
+  // limits is refused).
+  if (const int armed = runs.Column("armed_s"); armed >= 0) {
+    json never = json::array();
+    for (std::size_t r = 0; r < n; ++r) {
+      if (runs.Number(r, armed) == 0.0) never.push_back(run_id(r));
+    }
+    s["runs_never_armed"] = never;
+  }
   // The leg-stroke barriers' band (not in "held": the limits the campaign
   // judges are the configured axis limits).
   {
@@ -405,6 +415,18 @@ std::string SummaryMarkdown(const json& s) {
       << s["runs_beyond_leg_stroke_margin_tolerance"].get<long>()
       << " by more than the tolerance; worst margin "
       << Fmt("%.2f", s["leg_stroke_worst_margin_m"].get<double>() * 1e3) << " mm\n";
+  }
+  if (s.contains("runs_never_armed")) {
+    const json& never = s["runs_never_armed"];
+    o << "- runs whose supervisor never armed (the filter called the start outside its limits; "
+         "the drive stayed off): "
+      << never.size();
+    constexpr std::size_t kListed = 10;
+    for (std::size_t i = 0; i < never.size() && i < kListed; ++i) {
+      o << (i == 0 ? " (index " : ", ") << never[i]["index"].get<long>();
+    }
+    if (!never.empty()) o << (never.size() > kListed ? ", ...)" : ")");
+    o << "\n";
   }
   o << "- failed runs: " << s["failed_runs"].size() << "\n";
   for (const json& f : s["failed_runs"]) {

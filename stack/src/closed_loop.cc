@@ -272,6 +272,7 @@ ClosedLoopSummary RunClosedLoop(const StackConfig& config, const Scenario& scena
     out.model_evaluations_shared = shared_terms->hits();
   }
   out.endstop_hits = plant.counters().endstop_hits;
+  out.armed_s = static_cast<double>(safety.supervisor().motion_time_us()) * 1e-6;
   out.stiff_fallbacks = plant.counters().stiff_fallbacks;
   out.estimator_rejections = estimator_counters.rejected_inputs();
   if (!out.failure.empty()) return out;

@@ -100,6 +100,12 @@ TEST(Campaign, ExactModelHoldsAndSummaryAgreesWithTheRows) {
   EXPECT_EQ(s["failed_runs"].size(), 0u);
   EXPECT_GT(s["worst_position_margin_m"]["min"].get<double>(), 0.0);
   for (const auto& limit : s["limits"]) EXPECT_EQ(limit["runs_beyond_tolerance"], 0);
+  // The supervisor armed in both (auto-arm after its start-up checks): the
+  // motion clock ran for most of the 1.5 s.
+  for (std::size_t r = 0; r < table.rows.size(); ++r) {
+    EXPECT_GT(table.Number(r, table.Column("armed_s")), 1.0) << "row " << r;
+  }
+  EXPECT_EQ(s["runs_never_armed"].size(), 0u);
   // A row edited to exceed x by 2 mm is counted, and named.
   CsvTable edited = table;
   edited.rows[1][static_cast<std::size_t>(edited.Column("x_upper_excess"))] = "0.002";
@@ -108,6 +114,15 @@ TEST(Campaign, ExactModelHoldsAndSummaryAgreesWithTheRows) {
   EXPECT_EQ(e["limits"][0]["limit"], "x_upper");
   EXPECT_EQ(e["limits"][0]["runs_beyond_tolerance"], 1);
   EXPECT_EQ(e["limits"][0]["worst_run"]["index"], 1);
+  // A row whose supervisor never armed is named in the health section.
+  edited.rows[0][static_cast<std::size_t>(edited.Column("armed_s"))] = "0";
+  const nlohmann::json a = SummarizeCampaign(edited, {}, 1e-3);
+  ASSERT_EQ(a["runs_never_armed"].size(), 1u);
+  EXPECT_EQ(a["runs_never_armed"][0]["index"], 0);
+  EXPECT_NE(SummaryMarkdown(a).find("supervisor never armed (the filter called the start outside "
+                                    "its limits; the drive stayed off): 1 (index 0)"),
+            std::string::npos)
+      << SummaryMarkdown(a);
   std::filesystem::remove_all(dir);
 }
 

@@ -79,7 +79,12 @@ struct ClosedLoopSummary {
   /// at each end): the smallest distance inside it over the run (m),
   /// negative when a leg went beyond it. 1e9 without leg-stroke barriers.
   double leg_stroke_worst_margin_m = 1e9;
-  long stiff_fallbacks = 0;       ///< plant intervals the BDF fallback integrated (Plant)
+  long stiff_fallbacks = 0;  ///< plant intervals the BDF fallback integrated (Plant)
+  /// Stack time the supervisor spent ARMING or ARMED (its motion clock, s):
+  /// 0 when it never armed (it refuses a start outside the filter's limits,
+  /// docs/operations.md "Arming and e-stop"), and the run then shows the
+  /// plant with its drive off, not the stack.
+  double armed_s = 0.0;
   long estimator_rejections = 0;  ///< sensor samples or updates the estimator rejected
   long saturated_ticks = 0;       ///< ticks where |F*_i| exceeded the actuator force limit
   double max_force_n = 0.0;
