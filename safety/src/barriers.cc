@@ -49,6 +49,7 @@ void EvaluatePreparedBarriers(const ConstraintSet& c, const Vector6d& q, const V
   const bool robust = (d_bound.array() > 0.0).any();
   e.outside_position_set = false;
   e.outside_safe_set = false;
+  e.outside_unrecoverably = false;
   x->m_qd.noalias() = terms.M * qd;
   x->qd_m_qd = qd.dot(x->m_qd);
 
@@ -69,8 +70,9 @@ void EvaluatePreparedBarriers(const ConstraintSet& c, const Vector6d& q, const V
         e.outside_safe_set = true;
         // Its recovery barrier steers back (axis limits have one whenever
         // any exist, the legs' strokes when has_leg_recovery).
-        e.outside_position_set =
-            e.outside_position_set || (axis ? c.has_recovery : c.has_leg_recovery);
+        const bool recovers = axis ? c.has_recovery : c.has_leg_recovery;
+        e.outside_position_set = e.outside_position_set || recovers;
+        e.outside_unrecoverably = e.outside_unrecoverably || !recovers;
       }
       e.h_position[k] = -kinetic + s.alpha_e * h;
       e.alpha_h_position[k] = s.alpha * e.h_position[k];
@@ -119,7 +121,7 @@ void EvaluatePreparedBarriers(const ConstraintSet& c, const Vector6d& q, const V
       e.velocity_active[k] = true;
       if (s.recovery_of < 0) {
         e.h_velocity[k] = s.sign * (rate_of(s) - s.limit);
-        if (e.h_velocity[k] < 0.0) e.outside_safe_set = true;
+        if (e.h_velocity[k] < 0.0) e.outside_safe_set = e.outside_unrecoverably = true;
       } else {
         const PositionBarrierSpec& p = c.position[static_cast<size_t>(s.recovery_of)];
         const double value =

@@ -40,7 +40,9 @@ void Supervisor::Enter(SupervisorState next, const std::string& reason) {
 std::string Supervisor::ArmBlocker() const {
   if (!has_step_) return "no state estimate yet";
   if (!last_step_.state_usable) return "state estimate not usable (estimator not converged)";
-  if (!last_step_.inside_limits) return "pose or velocity outside the limits";
+  if (!last_step_.limits_allow_arming) {
+    return "velocity outside its limits, or pose outside a limit nothing steers back from";
+  }
   if (!last_step_.filtered) return "no fresh nominal command (controller)";
   return "";
 }

@@ -14,7 +14,7 @@ constexpr int64_t kPeriodUs = 1000;
 SupervisorStep Good(int64_t k) {
   SupervisorStep s;
   s.utime = s.sample_utime = k * kPeriodUs;
-  s.state_usable = s.inside_limits = s.filtered = true;
+  s.state_usable = s.limits_allow_arming = s.filtered = true;
   return s;
 }
 
@@ -73,10 +73,10 @@ TEST(Supervisor, ArmIsRefusedUnlessEverythingIsReady) {
   EXPECT_FALSE(Do(&s, OperatorCommand::kArm, &why));
   EXPECT_NE(why.find("not usable"), std::string::npos) << why;
   step = Good(1);
-  step.inside_limits = false;
+  step.limits_allow_arming = false;
   s.OnStep(step);
   EXPECT_FALSE(Do(&s, OperatorCommand::kArm, &why));
-  EXPECT_NE(why.find("outside the limits"), std::string::npos) << why;
+  EXPECT_NE(why.find("outside its limits"), std::string::npos) << why;
   step = Good(2);
   step.filtered = false;
   s.OnStep(step);

@@ -63,6 +63,11 @@ struct BarrierEvaluation {
   bool outside_position_set = false;
   /// Some velocity limit or (inside) position limit is exceeded: h < 0.
   bool outside_safe_set = false;
+  /// Of those: some velocity limit (not a recovery barrier) is exceeded, or
+  /// some position limit without a recovery barrier to steer back is. Outside
+  /// the set but neither of these, the recovery barriers steer back in (the
+  /// supervisor arms there).
+  bool outside_unrecoverably = false;
   Vector6d g_p = Vector6d::Zero();  ///< dPsi_p/dF (W/N = m/s)
   Vector6d g_v = Vector6d::Zero();  ///< dPsi_v/dF (m/s^2 per N)
 };

@@ -85,7 +85,7 @@ struct SupervisorConfig {
   bool hold_drive_off = true;
   double hold_brake_s = 0.5;
   /// Arm by itself at the first filtered step that allows arming (a usable
-  /// state inside the limits and a fresh nominal command): simulation's
+  /// state the limits allow arming at and a fresh nominal command): simulation's
   /// stand-in for the operator. Never on hardware (tools/launch.sh sets it
   /// in simulation only).
   bool auto_arm = false;
@@ -125,11 +125,13 @@ struct SupervisorMode {
 
 /// What the supervisor saw at one step of the safety process.
 struct SupervisorStep {
-  int64_t utime = 0;           ///< stack time of the state (us)
-  int64_t sample_utime = 0;    ///< its sensor sample
-  bool state_usable = false;   ///< estimator converged, not diverged
-  bool inside_limits = false;  ///< the state is inside every limit of the filter
-  bool filtered = false;       ///< a fresh nominal command was filtered (not a fallback)
+  int64_t utime = 0;          ///< stack time of the state (us)
+  int64_t sample_utime = 0;   ///< its sensor sample
+  bool state_usable = false;  ///< estimator converged, not diverged
+  /// The state is inside every limit of the filter, or outside only position
+  /// limits whose recovery barriers steer it back (velocities inside theirs).
+  bool limits_allow_arming = false;
+  bool filtered = false;  ///< a fresh nominal command was filtered (not a fallback)
 };
 
 class Supervisor {
