@@ -17,14 +17,6 @@
 namespace stewart::safety::test {
 namespace {
 
-SupervisorConfig AutoArmAtOnce() {
-  SupervisorConfig c;
-  c.auto_arm = true;
-  c.arming_ramp_s = 0.0;
-  c.fallback_latch_s = 0.0;
-  return c;
-}
-
 double LimitOf(const SafetyProcess& process, const std::string& name) {
   for (const PositionBarrierSpec& s : process.filter().constraints().position) {
     if (s.name == name) return s.limit;
@@ -64,7 +56,7 @@ Outcome RunAt(SafetyProcess* process, const Vector6d& q, const Vector6d& qd, int
 TEST(ArmingOutside, ArmsAtRestOutsideAPositionLimitAndSteersBack) {
   const StackConfig& c = DefaultConfig();
   HealthCounters counters("arming outside test");
-  SafetyProcess process(c.platform, c.safety, c.actuators, AutoArmAtOnce(), nullptr, &counters);
+  SafetyProcess process(c.platform, c.safety, c.actuators, ArmedAtOnce(), nullptr, &counters);
   Vector6d q = c.home_pose;
   q(0) = LimitOf(process, "x_upper") + 2e-3;  // 2 mm beyond, at rest
   const Outcome o = RunAt(&process, q, Vector6d::Zero(), 5);
@@ -80,7 +72,7 @@ TEST(ArmingOutside, ArmsAtRestOutsideAPositionLimitAndSteersBack) {
 TEST(ArmingOutside, RefusesAPlatformFasterThanAVelocityLimit) {
   const StackConfig& c = DefaultConfig();
   HealthCounters counters("arming outside test");
-  SafetyProcess process(c.platform, c.safety, c.actuators, AutoArmAtOnce(), nullptr, &counters);
+  SafetyProcess process(c.platform, c.safety, c.actuators, ArmedAtOnce(), nullptr, &counters);
   Vector6d qd = Vector6d::Zero();
   qd(2) = 0.02;  // zd above its 10 mm/s limit, inside every position limit
   const Outcome o = RunAt(&process, c.home_pose, qd, 5);

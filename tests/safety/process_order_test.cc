@@ -15,16 +15,6 @@
 namespace stewart::safety::test {
 namespace {
 
-// Arms at the first filtered step, at once: these tests are about the order
-// of messages, not about arming.
-SupervisorConfig ArmedAtOnce() {
-  SupervisorConfig c;
-  c.auto_arm = true;
-  c.arming_ramp_s = 0.0;
-  c.fallback_latch_s = 0.0;
-  return c;
-}
-
 struct Answer {
   int64_t sample_utime;
   Vector6d force_n;

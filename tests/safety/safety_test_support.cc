@@ -98,6 +98,14 @@ Vector6d RandomNominalForce(const DynamicsTerms& terms, std::mt19937* rng) {
   return InverseDynamics(terms, qdd);
 }
 
+SupervisorConfig ArmedAtOnce() {
+  SupervisorConfig c;
+  c.auto_arm = true;
+  c.arming_ramp_s = 0.0;
+  c.fallback_latch_s = 0.0;
+  return c;
+}
+
 double RelativeError(const Vector6d& a, const Vector6d& b) {
   return (a - b).norm() / std::max(b.norm(), 1.0);
 }

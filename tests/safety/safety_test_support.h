@@ -5,6 +5,7 @@
 #include "stewart/config/stack_config.h"
 #include "stewart/model/dynamics.h"
 #include "stewart/safety/safety_filter.h"
+#include "stewart/safety/supervisor.h"
 
 namespace stewart::safety::test {
 
@@ -46,6 +47,11 @@ FilterInput AtRestPushedAlongX(double accel_mps2);
 
 /// The leg forces that hold the platform at rest at q (H F = G).
 Vector6d HoverForce(const Vector6d& q);
+
+/// A supervisor that arms by itself at the first filtered step, at once (no
+/// ramp), and latches the first fallback while moving: for tests about what
+/// the safety process answers, not about arming.
+SupervisorConfig ArmedAtOnce();
 
 /// Relative difference ||a - b|| / max(||b||, 1 N).
 double RelativeError(const Vector6d& a, const Vector6d& b);
