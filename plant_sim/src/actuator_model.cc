@@ -94,6 +94,15 @@ Vector6d DcMotorLegForce(const ActuatorConfig& actuators, const PlantInputs& inp
   return force;
 }
 
+double DcMotorUndrivenResistanceN(const ActuatorConfig& actuators, double coulomb_error_n,
+                                  bool power_off, double leg_speed_mps) {
+  const DcMotorParams& motor = actuators.motor;
+  const double speed = std::abs(leg_speed_mps);
+  const double b_emf = power_off ? 0.0 : DcMotorBackEmfDampingNspm(motor);
+  return (b_emf + actuators.viscous_friction_nspm) * speed +
+         (motor.back_drive_force_n + coulomb_error_n) * std::tanh(speed / kCoulombSpeedScaleMps);
+}
+
 Vector6d ForceLagRate(const ActuatorConfig& actuators, const Vector6d& force_sat_n,
                       const Vector6d& force_motor_n) {
   return (force_sat_n - force_motor_n) / actuators.force_lag_s;

@@ -1,5 +1,6 @@
 #include "stewart/plant_sim/plant.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <stdexcept>
@@ -24,7 +25,8 @@ constexpr int kMotionStateSize = 12;
 
 // DC motor: a leg slower than this with its motor not energised is taken
 // hold of by its self-locking screw (m/s; a tenth of the dry friction's
-// smoothing speed, so the friction is nearly at full strength there).
+// smoothing speed). Faster legs are caught once the load on them is below
+// the back-drive force (Plant::UpdateSelfLocking).
 constexpr double kHoldSpeedMps = 1e-4;
 
 int OdeSizeFor(const ActuatorConfig& actuators) {
@@ -123,6 +125,10 @@ void Plant::UpdateSelfLocking() {
   const Vector6d leg_speed_mps = rates.terms.H.transpose() * qd();
   const Vector6d& leg_length_m = rates.terms.leg_length_m;
   const double c_hold = DcMotorHoldDampingNspm(motor);
+  // Ldd = H^T qdd + Jdot_l qd (m/s^2): with the speed, it tells a leg that
+  // friction is slowing from one its load drives on.
+  const Vector6d leg_accel_mps2 =
+      rates.terms.H.transpose() * rates.x_dot.segment<6>(6) + rates.terms.leg_bias_accel_mps2;
   bool changed = false;
   for (int i = 0; i < kNumLegs; ++i) {
     bool& held = inputs_.leg_held[static_cast<size_t>(i)];
@@ -135,9 +141,15 @@ void Plant::UpdateSelfLocking() {
           motor.lock_stiffness_npm * (leg_length_m(i) - inputs_.hold_length_m(i)) +
           c_hold * leg_speed_mps(i);
       hold = std::abs(spring_n) <= motor.back_drive_force_n;
-    } else if (std::abs(leg_speed_mps(i)) < kHoldSpeedMps) {
+    } else if (std::abs(leg_speed_mps(i)) < kHoldSpeedMps ||
+               UndrivenLoadEstimateN(i, leg_speed_mps(i), leg_accel_mps2(i)) <
+                   motor.back_drive_force_n) {
       hold = true;
-      inputs_.hold_length_m(i) = leg_length_m(i);
+      // The spring starts at the length where it carries nothing at this
+      // speed, k (L_held - L) = c Ld: the leg force stays continuous (no
+      // catch impulse) and the leg stops a few micrometres on.
+      inputs_.hold_length_m(i) =
+          leg_length_m(i) + c_hold * leg_speed_mps(i) / motor.lock_stiffness_npm;
       ++self_lock_engagements_;
     }
     if (hold != held) {
@@ -146,6 +158,20 @@ void Plant::UpdateSelfLocking() {
     }
   }
   if (changed) MarkDiscontinuity();
+}
+
+double Plant::UndrivenLoadEstimateN(int leg, double leg_speed_mps, double leg_accel_mps2) const {
+  // The smoothed dry friction lets a leg loaded below the back-drive force
+  // creep at the speed where the smoothed force meets the load; the screw
+  // would stop it. The load is the resistance at this speed plus what
+  // accelerates the leg onwards (the rotor's mass, the least the leg
+  // carries): one that friction is slowing, or that creeps steadily, is
+  // under its resistance; one driven on faster is not caught.
+  const double resistance_n =
+      DcMotorUndrivenResistanceN(model_.actuators, model_.actuator_errors.coulomb_friction_n(leg),
+                                 inputs_.legs_locked, leg_speed_mps);
+  const double onward_accel_mps2 = leg_speed_mps >= 0.0 ? leg_accel_mps2 : -leg_accel_mps2;
+  return resistance_n + model_.actuators.motor.reflected_mass_kg * std::max(onward_accel_mps2, 0.0);
 }
 
 void Plant::SetActuatorsOff(bool off) {

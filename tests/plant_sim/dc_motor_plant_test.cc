@@ -10,6 +10,7 @@
 #include "stewart/model/dc_motor.h"
 #include "stewart/model/kinematics.h"
 #include "stewart/plant_sim/actuator_model.h"
+#include "stewart/plant_sim/plant_dynamics.h"
 
 namespace stewart {
 namespace {
@@ -145,6 +146,76 @@ TEST(DcMotorLeg, SelfLockingHoldsBelowTheBackDriveForceAndGivesWayAbove) {
       EXPECT_LT(std::abs(sink_m), 2.0 * f_bd / model.actuators.motor.lock_stiffness_npm);
     } else {
       EXPECT_GT(sink_m, 1e-3);
+    }
+  }
+}
+
+// The resistance the catch reads is the force law's: for a leg whose motor
+// is not energised (zero duty, or the power off) and that no spring holds,
+// the back-EMF, viscous and dry friction opposing its motion.
+TEST(DcMotorLeg, UndrivenResistanceIsTheForceLawsOpposition) {
+  const PlantModel model = DcMotorModel();
+  const Vector6d coulomb_error_n = (Vector6d() << 0.0, 0.1, 0.2, 0.3, 0.0, 0.25).finished();
+  const Vector6d lengths = Vector6d::Constant(model.actuators.min_length_m + 0.1);
+  const Vector6d speeds =
+      (Vector6d() << -4e-3, -1e-3, -2e-4, 3e-5, 7e-4, 2.5e-3).finished();  // m/s
+  for (const bool power_off : {false, true}) {
+    PlantInputs inputs;
+    inputs.legs_locked = power_off;
+    const Vector6d force_n = DcMotorLegForce(model.actuators, inputs, lengths, speeds) +
+                             FrictionForce(model.actuators, speeds) +
+                             CoulombFrictionForce(coulomb_error_n, speeds);
+    for (int i = 0; i < kNumLegs; ++i) {
+      const double resistance_n =
+          DcMotorUndrivenResistanceN(model.actuators, coulomb_error_n(i), power_off, speeds(i));
+      EXPECT_GT(resistance_n, 0.0);
+      EXPECT_NEAR(resistance_n, speeds(i) > 0.0 ? -force_n(i) : force_n(i),
+                  1e-12 * std::abs(force_n(i)))
+          << i << " " << power_off;
+    }
+  }
+}
+
+// A leg moving slowly with its drive off (inside the dead band, or the power
+// off) under a load below its back-drive force comes to rest and stays: the
+// screw's dry friction would stop it, so the simulator's smoothed friction
+// must not let it creep on at the speed where the smoothed force meets the
+// load. One above the back-drive force keeps sinking.
+TEST(DcMotorLeg, SelfLockingStopsAMovingLegBelowTheBackDriveForce) {
+  const PlantModel model = DcMotorModel();
+  const double f_bd = model.actuators.motor.back_drive_force_n;
+  const Vector6d q0 = Config().plant_sim.initial_pose;
+  const Vector6d per_newton =
+      StaticLegForces(model.platform, q0, 1.0) - StaticLegForces(model.platform, q0, 0.0);
+  const Vector6d weight_n = StaticLegForces(model.platform, q0, 0.0);
+  const double hold_load_n = ((0.6 * f_bd - weight_n.array()) / per_newton.array()).minCoeff();
+  const double slip_load_n = ((1.2 * f_bd - weight_n.array()) / per_newton.array()).maxCoeff();
+  Vector6d sinking = Vector6d::Zero();
+  sinking(2) = -0.003;  // m/s
+  for (const bool power_off : {false, true}) {
+    for (const double load_n : {hold_load_n, slip_load_n}) {
+      Plant plant(model, test::OdeOptionsFor("arkode_erk"));
+      plant.Reset(0.0, q0, sinking);
+      plant.SetDutyCommand(Vector6d::Zero());
+      plant.SetActuatorsOff(power_off);
+      Vector6d wrench = Vector6d::Zero();
+      wrench(2) = -load_n;
+      plant.SetExternalWrench(wrench);
+      for (int k = 0; k < 300; ++k) plant.Advance(1e-3);  // 0.3 s to come to rest
+      const double z0 = plant.q()(2);
+      for (int k = 0; k < 1000; ++k) plant.Advance(1e-3);
+      const double sink_m = z0 - plant.q()(2);
+      spdlog::info("power {}, load {:.1f} N: sank {:.2e} m in the second after 0.3 s, {} catches",
+                   power_off ? "off" : "on, zero duty", load_n, sink_m,
+                   plant.counters().self_lock_engagements);
+      if (load_n == hold_load_n) {
+        EXPECT_GE(plant.counters().self_lock_engagements, kNumLegs) << power_off;
+        EXPECT_LT(std::abs(sink_m), 2.0 * f_bd / model.actuators.motor.lock_stiffness_npm)
+            << power_off;
+        EXPECT_LT(LegSpeed(plant).cwiseAbs().maxCoeff(), 1e-6) << power_off;
+      } else {
+        EXPECT_GT(sink_m, 1e-3) << power_off;
+      }
     }
   }
 }

@@ -91,10 +91,15 @@ class Plant {
   void ApplyCommand(const Vector6d& command);
   // DC motor: which legs the self-locking screws hold, judged at the state
   // now (between integration intervals): a leg whose motor is not energised
-  // is taken hold of once its speed falls below kHoldSpeedMps, and let go
+  // is taken hold of once its speed falls below kHoldSpeedMps or the load
+  // on it is below the back-drive force (UndrivenLoadEstimateN), and let go
   // when the motor is energised or its spring carries more than the
   // back-drive force.
   void UpdateSelfLocking();
+  // The axial load on a leg whose motor is not energised, as its motion
+  // shows it (N): the smoothed resistance at its speed plus the rotor's
+  // mass times its acceleration away from rest.
+  double UndrivenLoadEstimateN(int leg, double leg_speed_mps, double leg_accel_mps2) const;
   void IntegrateTo(double t_end);
   // The integration loop of IntegrateTo with `integrator`, from (t_s_, x_);
   // throws as OdeIntegrator::Advance does.
