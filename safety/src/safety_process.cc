@@ -215,10 +215,10 @@ SafetyOutput SafetyProcess::Supervise(const StateSample& state, const Vector6d& 
   step.utime = state.utime;
   step.sample_utime = state.sample_utime;
   step.state_usable = StateUsable(state);
-  // Outside a position limit at rest the recovery barriers steer back in, so
-  // arming is allowed there: refused, a platform resting in the joint
-  // tolerance's band of a limit could never move, and lead screws back-driven
-  // by its load let it creep through the limit with the drive off.
+  // Outside a position limit whose recovery barrier steers back in, with
+  // every velocity inside its limit, arming is allowed: refused, a platform
+  // resting in the joint tolerance's band of a limit could never move, and a
+  // load above the screws' back-drive force moves it with the drive off.
   step.limits_allow_arming = filtered && (diagnostics_.flags & kFlagInvalidInput) == 0 &&
                              !diagnostics_.barriers.outside_unrecoverably;
   step.filtered = filtered;
