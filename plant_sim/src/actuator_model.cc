@@ -94,13 +94,15 @@ Vector6d DcMotorLegForce(const ActuatorConfig& actuators, const PlantInputs& inp
   return force;
 }
 
-double DcMotorUndrivenResistanceN(const ActuatorConfig& actuators, double coulomb_error_n,
-                                  bool power_off, double leg_speed_mps) {
-  const DcMotorParams& motor = actuators.motor;
-  const double speed = std::abs(leg_speed_mps);
-  const double b_emf = power_off ? 0.0 : DcMotorBackEmfDampingNspm(motor);
-  return (b_emf + actuators.viscous_friction_nspm) * speed +
-         (motor.back_drive_force_n + coulomb_error_n) * std::tanh(speed / kCoulombSpeedScaleMps);
+Vector6d DcMotorUndrivenResistanceN(const ActuatorConfig& actuators,
+                                    const Vector6d& coulomb_error_n, bool power_off,
+                                    const Vector6d& leg_length_m, const Vector6d& leg_speed_mps) {
+  PlantInputs undriven;  // zero duty, no leg held
+  undriven.legs_locked = power_off;
+  const Vector6d force_n = DcMotorLegForce(actuators, undriven, leg_length_m, leg_speed_mps) +
+                           FrictionForce(actuators, leg_speed_mps) +
+                           CoulombFrictionForce(coulomb_error_n, leg_speed_mps);
+  return -force_n.cwiseProduct(leg_speed_mps.cwiseSign());
 }
 
 Vector6d ForceLagRate(const ActuatorConfig& actuators, const Vector6d& force_sat_n,

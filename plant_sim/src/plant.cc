@@ -1,6 +1,5 @@
 #include "stewart/plant_sim/plant.h"
 
-#include <algorithm>
 #include <array>
 #include <cmath>
 #include <stdexcept>
@@ -129,6 +128,8 @@ void Plant::UpdateSelfLocking() {
   // friction is slowing from one its load drives on.
   const Vector6d leg_accel_mps2 =
       rates.terms.H.transpose() * rates.x_dot.segment<6>(6) + rates.terms.leg_bias_accel_mps2;
+  const Vector6d undriven_load_n =
+      UndrivenLoadEstimateN(leg_length_m, leg_speed_mps, leg_accel_mps2);
   bool changed = false;
   for (int i = 0; i < kNumLegs; ++i) {
     bool& held = inputs_.leg_held[static_cast<size_t>(i)];
@@ -142,8 +143,7 @@ void Plant::UpdateSelfLocking() {
           c_hold * leg_speed_mps(i);
       hold = std::abs(spring_n) <= motor.back_drive_force_n;
     } else if (std::abs(leg_speed_mps(i)) < kHoldSpeedMps ||
-               UndrivenLoadEstimateN(i, leg_speed_mps(i), leg_accel_mps2(i)) <
-                   motor.back_drive_force_n) {
+               undriven_load_n(i) < motor.back_drive_force_n) {
       hold = true;
       // The spring starts at the length where it carries nothing at this
       // speed, k (L_held - L) = c Ld: the leg force stays continuous (no
@@ -160,18 +160,19 @@ void Plant::UpdateSelfLocking() {
   if (changed) MarkDiscontinuity();
 }
 
-double Plant::UndrivenLoadEstimateN(int leg, double leg_speed_mps, double leg_accel_mps2) const {
+Vector6d Plant::UndrivenLoadEstimateN(const Vector6d& leg_length_m, const Vector6d& leg_speed_mps,
+                                      const Vector6d& leg_accel_mps2) const {
   // The smoothed dry friction lets a leg loaded below the back-drive force
   // creep at the speed where the smoothed force meets the load; the screw
   // would stop it. The load is the resistance at this speed plus what
   // accelerates the leg onwards (the rotor's mass, the least the leg
   // carries): one that friction is slowing, or that creeps steadily, is
   // under its resistance; one driven on faster is not caught.
-  const double resistance_n =
-      DcMotorUndrivenResistanceN(model_.actuators, model_.actuator_errors.coulomb_friction_n(leg),
-                                 inputs_.legs_locked, leg_speed_mps);
-  const double onward_accel_mps2 = leg_speed_mps >= 0.0 ? leg_accel_mps2 : -leg_accel_mps2;
-  return resistance_n + model_.actuators.motor.reflected_mass_kg * std::max(onward_accel_mps2, 0.0);
+  const Vector6d resistance_n =
+      DcMotorUndrivenResistanceN(model_.actuators, model_.actuator_errors.coulomb_friction_n,
+                                 inputs_.legs_locked, leg_length_m, leg_speed_mps);
+  const Vector6d onward_accel_mps2 = leg_accel_mps2.cwiseProduct(leg_speed_mps.cwiseSign());
+  return resistance_n + model_.actuators.motor.reflected_mass_kg * onward_accel_mps2.cwiseMax(0.0);
 }
 
 void Plant::SetActuatorsOff(bool off) {

@@ -114,6 +114,23 @@ Vector6d StaticLegForces(const PlatformParams& platform, const Vector6d& q, doub
                          GeneralisedForceOfWrench(q, wrench));
 }
 
+// Downward loads on the platform at rest at q (N): `hold_n` puts at most
+// hold_fraction of the back-drive force on any leg, `slip_n` at least
+// slip_fraction of it on every leg.
+struct BackDriveLoads {
+  double hold_n = 0.0;
+  double slip_n = 0.0;
+};
+BackDriveLoads LoadsAroundTheBackDriveForce(const PlantModel& model, const Vector6d& q,
+                                            double hold_fraction, double slip_fraction) {
+  const double f_bd = model.actuators.motor.back_drive_force_n;
+  const Vector6d weight_n = StaticLegForces(model.platform, q, 0.0);
+  const Vector6d per_newton = StaticLegForces(model.platform, q, 1.0) - weight_n;
+  EXPECT_TRUE((per_newton.array() > 0.0).all());
+  return {((hold_fraction * f_bd - weight_n.array()) / per_newton.array()).minCoeff(),
+          ((slip_fraction * f_bd - weight_n.array()) / per_newton.array()).maxCoeff()};
+}
+
 // Zero duty: the screws hold the platform under a load that puts at most 80 %
 // of the back-drive force on any leg, and give way under one that puts at
 // least 120 % on every leg.
@@ -121,12 +138,9 @@ TEST(DcMotorLeg, SelfLockingHoldsBelowTheBackDriveForceAndGivesWayAbove) {
   const PlantModel model = DcMotorModel();
   const double f_bd = model.actuators.motor.back_drive_force_n;
   const Vector6d q0 = Config().plant_sim.initial_pose;
-  const Vector6d per_newton =
-      StaticLegForces(model.platform, q0, 1.0) - StaticLegForces(model.platform, q0, 0.0);
-  const Vector6d weight_n = StaticLegForces(model.platform, q0, 0.0);
-  ASSERT_TRUE((per_newton.array() > 0.0).all());
-  const double hold_load_n = ((0.8 * f_bd - weight_n.array()) / per_newton.array()).minCoeff();
-  const double slip_load_n = ((1.2 * f_bd - weight_n.array()) / per_newton.array()).maxCoeff();
+  const BackDriveLoads loads = LoadsAroundTheBackDriveForce(model, q0, 0.8, 1.2);
+  const double hold_load_n = loads.hold_n;
+  const double slip_load_n = loads.slip_n;
 
   for (const double load_n : {hold_load_n, slip_load_n}) {
     Plant plant(model, test::OdeOptionsFor("arkode_erk"));
@@ -150,28 +164,28 @@ TEST(DcMotorLeg, SelfLockingHoldsBelowTheBackDriveForceAndGivesWayAbove) {
   }
 }
 
-// The resistance the catch reads is the force law's: for a leg whose motor
-// is not energised (zero duty, or the power off) and that no spring holds,
-// the back-EMF, viscous and dry friction opposing its motion.
-TEST(DcMotorLeg, UndrivenResistanceIsTheForceLawsOpposition) {
+// The resistance the catch reads, for a leg whose motor is not energised
+// (zero duty, or the power off) and that no spring holds: back-EMF while
+// powered, the screw's viscous friction, and its dry friction at the
+// back-drive force plus the truth's extra, smoothed over 1 mm/s.
+TEST(DcMotorLeg, UndrivenResistanceIsDampingAndDryFriction) {
   const PlantModel model = DcMotorModel();
+  const DcMotorParams& m = model.actuators.motor;
   const Vector6d coulomb_error_n = (Vector6d() << 0.0, 0.1, 0.2, 0.3, 0.0, 0.25).finished();
   const Vector6d lengths = Vector6d::Constant(model.actuators.min_length_m + 0.1);
   const Vector6d speeds =
       (Vector6d() << -4e-3, -1e-3, -2e-4, 3e-5, 7e-4, 2.5e-3).finished();  // m/s
   for (const bool power_off : {false, true}) {
-    PlantInputs inputs;
-    inputs.legs_locked = power_off;
-    const Vector6d force_n = DcMotorLegForce(model.actuators, inputs, lengths, speeds) +
-                             FrictionForce(model.actuators, speeds) +
-                             CoulombFrictionForce(coulomb_error_n, speeds);
+    const Vector6d resistance_n =
+        DcMotorUndrivenResistanceN(model.actuators, coulomb_error_n, power_off, lengths, speeds);
+    const double damping_nspm =
+        (power_off ? 0.0 : DcMotorBackEmfDampingNspm(m)) + model.actuators.viscous_friction_nspm;
     for (int i = 0; i < kNumLegs; ++i) {
-      const double resistance_n =
-          DcMotorUndrivenResistanceN(model.actuators, coulomb_error_n(i), power_off, speeds(i));
-      EXPECT_GT(resistance_n, 0.0);
-      EXPECT_NEAR(resistance_n, speeds(i) > 0.0 ? -force_n(i) : force_n(i),
-                  1e-12 * std::abs(force_n(i)))
-          << i << " " << power_off;
+      const double speed = std::abs(speeds(i));
+      const double expected_n = damping_nspm * speed + (m.back_drive_force_n + coulomb_error_n(i)) *
+                                                           std::tanh(speed / 1e-3);
+      EXPECT_GT(resistance_n(i), 0.0);
+      EXPECT_NEAR(resistance_n(i), expected_n, 1e-12 * expected_n) << i << " " << power_off;
     }
   }
 }
@@ -185,11 +199,9 @@ TEST(DcMotorLeg, SelfLockingStopsAMovingLegBelowTheBackDriveForce) {
   const PlantModel model = DcMotorModel();
   const double f_bd = model.actuators.motor.back_drive_force_n;
   const Vector6d q0 = Config().plant_sim.initial_pose;
-  const Vector6d per_newton =
-      StaticLegForces(model.platform, q0, 1.0) - StaticLegForces(model.platform, q0, 0.0);
-  const Vector6d weight_n = StaticLegForces(model.platform, q0, 0.0);
-  const double hold_load_n = ((0.6 * f_bd - weight_n.array()) / per_newton.array()).minCoeff();
-  const double slip_load_n = ((1.2 * f_bd - weight_n.array()) / per_newton.array()).maxCoeff();
+  const BackDriveLoads loads = LoadsAroundTheBackDriveForce(model, q0, 0.6, 1.2);
+  const double hold_load_n = loads.hold_n;
+  const double slip_load_n = loads.slip_n;
   Vector6d sinking = Vector6d::Zero();
   sinking(2) = -0.003;  // m/s
   for (const bool power_off : {false, true}) {

@@ -55,14 +55,16 @@ Vector6d DcMotorLegForce(const ActuatorConfig& actuators, const PlantInputs& inp
 /// (at least 0.1 kg, so a massless rotor still damps).
 double DcMotorHoldDampingNspm(const DcMotorParams& motor);
 
-/// DC motor: the force opposing a leg whose motor is not energised while it
-/// moves at leg_speed_mps (N, >= 0): back-EMF damping (power on), the screw's
-/// viscous friction, its dry friction at the back-drive force and the truth's
-/// extra dry friction `coulomb_error_n`, all smoothed as in DcMotorLegForce.
-/// Below the back-drive force it is the speed range in which the smoothed
-/// friction, not the screw, decides how fast the leg creeps.
-double DcMotorUndrivenResistanceN(const ActuatorConfig& actuators, double coulomb_error_n,
-                                  bool power_off, double leg_speed_mps);
+/// DC motor: the force opposing each leg's motion were its motor not
+/// energised and no screw holding it (N, >= 0): -sign(Ld) times the sum of
+/// DcMotorLegForce at zero duty (back-EMF while powered, dry friction at the
+/// back-drive force), the screw's viscous friction and the truth's extra dry
+/// friction `coulomb_error_n`. Below the back-drive force it is the speed
+/// range in which the smoothed friction, not the screw, decides how fast a
+/// leg creeps.
+Vector6d DcMotorUndrivenResistanceN(const ActuatorConfig& actuators,
+                                    const Vector6d& coulomb_error_n, bool power_off,
+                                    const Vector6d& leg_length_m, const Vector6d& leg_speed_mps);
 
 /// First-order force lag tau dF/dt = F_sat - F (tau = force_lag_s > 0).
 Vector6d ForceLagRate(const ActuatorConfig& actuators, const Vector6d& force_sat_n,

@@ -96,10 +96,11 @@ class Plant {
   // when the motor is energised or its spring carries more than the
   // back-drive force.
   void UpdateSelfLocking();
-  // The axial load on a leg whose motor is not energised, as its motion
+  // The axial load on each leg were its motor not energised, as its motion
   // shows it (N): the smoothed resistance at its speed plus the rotor's
   // mass times its acceleration away from rest.
-  double UndrivenLoadEstimateN(int leg, double leg_speed_mps, double leg_accel_mps2) const;
+  Vector6d UndrivenLoadEstimateN(const Vector6d& leg_length_m, const Vector6d& leg_speed_mps,
+                                 const Vector6d& leg_accel_mps2) const;
   void IntegrateTo(double t_end);
   // The integration loop of IntegrateTo with `integrator`, from (t_s_, x_);
   // throws as OdeIntegrator::Advance does.
