@@ -272,8 +272,8 @@ json SummarizeCampaign(const CsvTable& runs, const json& meta, double tolerance)
   s["endstop_hits"] = total("endstop_hits");
   s["runs_with_stiff_fallbacks"] = count_positive("stiff_fallbacks");
   // Runs whose supervisor never armed: their limits were the plant's with the
-  // drive off, not the stack's doing (a start the filter calls outside its
-  // limits is refused).
+  // drive off, not the stack's doing (arming is refused without a usable
+  // estimate or outside a limit nothing steers back from).
   if (const int armed = runs.Column("armed_s"); armed >= 0) {
     json never = json::array();
     for (std::size_t r = 0; r < n; ++r) {
@@ -418,8 +418,8 @@ std::string SummaryMarkdown(const json& s) {
   }
   if (s.contains("runs_never_armed")) {
     const json& never = s["runs_never_armed"];
-    o << "- runs whose supervisor never armed (the filter called the start outside its limits; "
-         "the drive stayed off): "
+    o << "- runs whose supervisor never armed (no usable estimate, or a start outside a limit "
+         "nothing steers back from; the drive stayed off): "
       << never.size();
     constexpr std::size_t kListed = 10;
     for (std::size_t i = 0; i < never.size() && i < kListed; ++i) {

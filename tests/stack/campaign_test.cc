@@ -119,8 +119,9 @@ TEST(Campaign, ExactModelHoldsAndSummaryAgreesWithTheRows) {
   const nlohmann::json a = SummarizeCampaign(edited, {}, 1e-3);
   ASSERT_EQ(a["runs_never_armed"].size(), 1u);
   EXPECT_EQ(a["runs_never_armed"][0]["index"], 0);
-  EXPECT_NE(SummaryMarkdown(a).find("supervisor never armed (the filter called the start outside "
-                                    "its limits; the drive stayed off): 1 (index 0)"),
+  EXPECT_NE(SummaryMarkdown(a).find("supervisor never armed (no usable estimate, or a start "
+                                    "outside a limit nothing steers back from; the drive stayed "
+                                    "off): 1 (index 0)"),
             std::string::npos)
       << SummaryMarkdown(a);
   std::filesystem::remove_all(dir);

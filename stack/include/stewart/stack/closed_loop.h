@@ -81,9 +81,9 @@ struct ClosedLoopSummary {
   double leg_stroke_worst_margin_m = 1e9;
   long stiff_fallbacks = 0;  ///< plant intervals the BDF fallback integrated (Plant)
   /// Stack time the supervisor spent ARMING or ARMED (its motion clock, s):
-  /// 0 when it never armed (it refuses a start outside the filter's limits,
-  /// docs/operations.md "Arming and e-stop"), and the run then shows the
-  /// plant with its drive off, not the stack.
+  /// 0 when it never armed (it refuses without a usable estimate or outside a
+  /// limit nothing steers back from, docs/operations.md "Arming and e-stop"), and the run then
+  /// shows the plant with its drive off, not the stack.
   double armed_s = 0.0;
   long estimator_rejections = 0;  ///< sensor samples or updates the estimator rejected
   long saturated_ticks = 0;       ///< ticks where |F*_i| exceeded the actuator force limit
