@@ -1,10 +1,12 @@
 #include "stewart/stack/random_scenario.h"
 
 #include <algorithm>
+#include <optional>
 #include <sstream>
 
 #include "stewart/config/scenario_loader.h"
 #include "stewart/model/kinematics.h"
+#include "stewart/safety/constraint_set.h"
 
 namespace stewart {
 namespace {
@@ -12,6 +14,9 @@ namespace {
 // Room kept from the stroke ends for a random pose (m): the controller's
 // overshoot must not put a leg into an end-stop.
 constexpr double kStrokeMarginM = 0.01;
+// Room kept inside the filter's position limits for a random start (m): the
+// start is inside the safe set, not on its boundary.
+constexpr double kStartInsideLimitsM = 0.005;
 // Attempts to find a pose inside the stroke before giving up (the sampling box
 // is mostly inside, so a handful suffice).
 constexpr int kMaxAttempts = 1000;
@@ -26,15 +31,20 @@ bool InsideStroke(const StackConfig& c, const Vector6d& q) {
          (l.array() < c.platform.leg_max_length_m - kStrokeMarginM).all();
 }
 
-bool InsideLimits(const SafetyConfig& s, const Vector6d& q, double margin) {
+// `room_m` per axis: how far inside each configured position limit a pose
+// must be (m, rad).
+bool InsideLimits(const SafetyConfig& s, const Vector6d& q, const Vector6d& room_m) {
   for (const PositionLimitConfig& l : s.position_limits) {
-    if (l.upper && q(l.axis) > *l.upper - margin) return false;
-    if (l.lower && q(l.axis) < *l.lower + margin) return false;
+    if (l.upper && q(l.axis) > *l.upper - room_m(l.axis)) return false;
+    if (l.lower && q(l.axis) < *l.lower + room_m(l.axis)) return false;
   }
   return true;
 }
 
-Vector6d RandomPose(const StackConfig& c, std::mt19937_64* rng, bool inside_limits) {
+// A pose inside the stroke; with `room_m`, also that far inside every
+// position limit.
+Vector6d RandomPose(const StackConfig& c, std::mt19937_64* rng,
+                    const std::optional<Vector6d>& room_m) {
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
   for (int attempt = 0; attempt < kMaxAttempts; ++attempt) {
     Vector6d q = c.home_pose;
@@ -42,7 +52,7 @@ Vector6d RandomPose(const StackConfig& c, std::mt19937_64* rng, bool inside_limi
     q(1) += kTranslationRangeM * unit(*rng);
     q(2) += kZRangeM * unit(*rng);
     for (int a = 3; a < 6; ++a) q(a) += kRotationRangeRad * unit(*rng);
-    if (InsideStroke(c, q) && (!inside_limits || InsideLimits(c.safety, q, 0.005))) return q;
+    if (InsideStroke(c, q) && (!room_m || InsideLimits(c.safety, q, *room_m))) return q;
   }
   return c.home_pose;
 }
@@ -65,7 +75,7 @@ RandomRun MakeRandomRun(const StackConfig& config, double duration_s, std::mt199
   YAML::Node segments(YAML::NodeType::Sequence);
   for (int i = 0; i <= steps; ++i) {
     const bool last = i == steps;
-    const Vector6d q_des = last ? config.home_pose : RandomPose(config, rng, false);
+    const Vector6d q_des = last ? config.home_pose : RandomPose(config, rng, std::nullopt);
     YAML::Node segment;
     segment["start_s"] = last ? duration_s : starts[static_cast<size_t>(i)];
     segment["type"] = "step";
@@ -82,7 +92,12 @@ RandomRun MakeRandomRun(const StackConfig& config, double duration_s, std::mt199
   text << yaml;
   run.scenario = ParseScenario(text.str(), "random");
 
-  run.initial_pose = RandomPose(config, rng, true);
+  // The filter's position limits are the configured ones drawn in by the
+  // joints' tolerance: a start between the two would begin outside the safe
+  // set the filter keeps.
+  const Vector6d start_room_m =
+      safety::JointToleranceMargin(config.platform, config.safety).array() + kStartInsideLimitsM;
+  run.initial_pose = RandomPose(config, rng, start_room_m);
   for (const VelocityLimitConfig& l : config.safety.velocity_limits) {
     const double bound = 0.5 * std::min(l.upper ? *l.upper : 1e9, l.lower ? -*l.lower : 1e9);
     run.initial_velocity(l.axis) = bound * (2.0 * unit(*rng) - 1.0);

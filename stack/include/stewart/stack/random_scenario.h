@@ -15,7 +15,9 @@ namespace stewart {
 struct RandomRun {
   YAML::Node scenario_yaml;  ///< the scenario as a file (config/scenarios format)
   Scenario scenario{"random", 0.0, {}};
-  Vector6d initial_pose = Vector6d::Zero();      ///< inside every limit, at rest or moving
+  /// Inside the stroke and 5 mm inside every position limit the filter
+  /// keeps (the configured ones drawn in by the joints' tolerance).
+  Vector6d initial_pose = Vector6d::Zero();
   Vector6d initial_velocity = Vector6d::Zero();  ///< within half of every velocity limit
 };
 
