@@ -5,7 +5,9 @@
 #include <sstream>
 
 #include "stewart/config/scenario_loader.h"
+#include "stewart/model/dynamics.h"
 #include "stewart/model/kinematics.h"
+#include "stewart/safety/barriers.h"
 #include "stewart/safety/constraint_set.h"
 
 namespace stewart {
@@ -95,14 +97,38 @@ RandomRun MakeRandomRun(const StackConfig& config, double duration_s, std::mt199
   // The filter's position limits are the configured ones drawn in by the
   // joints' tolerance: a start between the two would begin outside the safe
   // set the filter keeps.
-  const Vector6d start_room_m =
-      safety::JointToleranceMargin(config.platform, config.safety).array() + kStartInsideLimitsM;
+  const safety::ConstraintSet constraints =
+      safety::BuildConstraintSet(config.platform, config.safety);
+  const Vector6d start_room_m = constraints.joint_tolerance_margin.array() + kStartInsideLimitsM;
   run.initial_pose = RandomPose(config, rng, start_room_m);
-  for (const VelocityLimitConfig& l : config.safety.velocity_limits) {
-    const double bound = 0.5 * std::min(l.upper ? *l.upper : 1e9, l.lower ? -*l.lower : 1e9);
-    run.initial_velocity(l.axis) = bound * (2.0 * unit(*rng) - 1.0);
+  // A velocity the energy barriers have room for (heavy rotors near a limit
+  // may not); after kMaxAttempts draws, at rest.
+  for (int attempt = 0; attempt < kMaxAttempts; ++attempt) {
+    for (const VelocityLimitConfig& l : config.safety.velocity_limits) {
+      const double bound = 0.5 * std::min(l.upper ? *l.upper : 1e9, l.lower ? -*l.lower : 1e9);
+      run.initial_velocity(l.axis) = bound * (2.0 * unit(*rng) - 1.0);
+    }
+    if (InsideSafeSet(config.platform, constraints, run.initial_pose, run.initial_velocity)) {
+      return run;
+    }
   }
+  run.initial_velocity.setZero();
   return run;
+}
+
+bool InsideSafeSet(const PlatformParams& platform, const safety::ConstraintSet& constraints,
+                   const Vector6d& q, const Vector6d& qd) {
+  const DynamicsTerms terms = EvaluateDynamics(platform, q, qd);
+  safety::BarrierEvaluation e;
+  safety::EvaluateBarriers(constraints, q, qd, terms, Vector6d::Zero(), &e);
+  for (int i = 0; i < constraints.num_position; ++i) {
+    if (!(e.h_position[static_cast<size_t>(i)] >= 0.0)) return false;
+  }
+  for (int i = 0; i < constraints.num_velocity; ++i) {
+    const size_t k = static_cast<size_t>(i);
+    if (constraints.velocity[k].recovery_of < 0 && !(e.h_velocity[k] >= 0.0)) return false;
+  }
+  return true;
 }
 
 }  // namespace stewart

@@ -14,6 +14,7 @@
 #include "stewart/config/config_loader.h"
 #include "stewart/safety/constraint_set.h"
 #include "stewart/stack/campaign_summary.h"
+#include "stewart/stack/random_scenario.h"
 
 namespace stewart {
 namespace {
@@ -56,34 +57,88 @@ TEST(Campaign, RowsAreTheSameWithAnyJobsAndShards) {
 
 // The random scenario starts inside the safe set the filter keeps: its
 // position limits are the configured ones drawn in by the joints'
-// tolerance, so a start 5 mm inside a configured limit can be outside them.
-TEST(Campaign, RandomStartsAreInsideTheFiltersLimits) {
-  const CampaignSpec spec = MakeCampaignSpec(DefaultConfigPath(), "random", "", 1, 0.0);
+// tolerance, so a start 5 mm inside a configured limit can be outside them;
+// and its energy barriers leave less room for speed where the legs' rotors
+// are heavy (the P-16P overlay).
+void ExpectRandomStartsInsideTheSafeSet(const std::string& config_path) {
+  const CampaignSpec spec = MakeCampaignSpec(config_path, "random", "", 1, 0.0);
   const SafetyConfig& safety = spec.config.safety;
-  const Vector6d margin = safety::JointToleranceMargin(spec.config.platform, safety);
-  ASSERT_GT(margin(0), 0.005) << "a tolerance wider than the start's room tests nothing";
+  const safety::ConstraintSet constraints =
+      safety::BuildConstraintSet(spec.config.platform, safety);
+  const Vector6d margin = constraints.joint_tolerance_margin;
+  ASSERT_GT(margin(0), 0.005) << "a tolerance narrower than the start's room tests nothing";
   for (long index = 0; index < 1000; ++index) {
     const RunSetup run = SetUpRun(spec, index);
-    const YAML::Node pose = run.truth_yaml["initial_state"]["pose"];
-    const YAML::Node velocity = run.truth_yaml["initial_state"]["velocity"];
+    Vector6d q, qd;
+    for (int a = 0; a < 6; ++a) {
+      q(a) = run.truth_yaml["initial_state"]["pose"][a].as<double>();
+      qd(a) = run.truth_yaml["initial_state"]["velocity"][a].as<double>();
+    }
     for (const PositionLimitConfig& l : safety.position_limits) {
-      const double q = pose[l.axis].as<double>();
       if (l.upper) {
-        EXPECT_LE(q, *l.upper - margin(l.axis) - 0.005) << "run " << index;
+        EXPECT_LE(q(l.axis), *l.upper - margin(l.axis) - 0.005) << "run " << index;
       }
       if (l.lower) {
-        EXPECT_GE(q, *l.lower + margin(l.axis) + 0.005) << "run " << index;
+        EXPECT_GE(q(l.axis), *l.lower + margin(l.axis) + 0.005) << "run " << index;
       }
     }
     for (const VelocityLimitConfig& l : safety.velocity_limits) {
-      const double qd = velocity[l.axis].as<double>();
       if (l.upper) {
-        EXPECT_LE(qd, 0.5 * *l.upper) << "run " << index;
+        EXPECT_LE(qd(l.axis), 0.5 * *l.upper) << "run " << index;
       }
       if (l.lower) {
-        EXPECT_GE(qd, 0.5 * *l.lower) << "run " << index;
+        EXPECT_GE(qd(l.axis), 0.5 * *l.lower) << "run " << index;
       }
     }
+    EXPECT_TRUE(InsideSafeSet(spec.config.platform, constraints, q, qd)) << "run " << index;
+  }
+}
+
+// The shipped config with the P-16P overlay, as a file (removed with the
+// object).
+struct P16pConfigFile {
+  std::string path =
+      testing::TempDir() + "/campaign_test_p16p_" + std::to_string(::getpid()) + ".yaml";
+  P16pConfigFile() {
+    YAML::Emitter merged;
+    merged << LoadMergedConfigYaml(
+        DefaultConfigPath(), {std::string(STEWART_SOURCE_DIR) + "/config/overlays/p16p.yaml"});
+    std::ofstream(path) << merged.c_str();
+  }
+  ~P16pConfigFile() { std::remove(path.c_str()); }
+};
+
+TEST(Campaign, RandomStartsAreInsideTheSafeSet) {
+  ExpectRandomStartsInsideTheSafeSet(DefaultConfigPath());
+  const P16pConfigFile p16p;
+  ExpectRandomStartsInsideTheSafeSet(p16p.path);
+}
+
+// 1 mm inside the filter's x limit, moving along x at half its velocity
+// limit: inside with the ideal legs (kinetic energy ~3e-5 J against
+// alpha_e h = 1e-3 J), outside with the P-16P rotors in M; at rest inside
+// with both; beyond the limit or too fast outside with both.
+TEST(Campaign, InsideSafeSetWeighsTheKineticEnergy) {
+  const P16pConfigFile p16p;
+  for (const std::string& path : {DefaultConfigPath(), p16p.path}) {
+    const StackConfig config = LoadStackConfig(path);
+    const safety::ConstraintSet constraints =
+        safety::BuildConstraintSet(config.platform, config.safety);
+    ASSERT_EQ(config.safety.position_limits[0].axis, 0);
+    const double x_limit_m =
+        *config.safety.position_limits[0].upper - constraints.joint_tolerance_margin(0);
+    Vector6d q = config.home_pose;
+    q(0) = x_limit_m - 0.001;
+    Vector6d qd = Vector6d::Zero();
+    EXPECT_TRUE(InsideSafeSet(config.platform, constraints, q, qd)) << path;
+    qd(0) = 0.0075;
+    EXPECT_EQ(InsideSafeSet(config.platform, constraints, q, qd), path == DefaultConfigPath())
+        << path;
+    qd(0) = 0.0;
+    qd(2) = 0.011;  // above the z velocity limit (0.010 m/s)
+    EXPECT_FALSE(InsideSafeSet(config.platform, constraints, config.home_pose, qd)) << path;
+    q(0) = x_limit_m + 0.0001;
+    EXPECT_FALSE(InsideSafeSet(config.platform, constraints, q, Vector6d::Zero())) << path;
   }
 }
 
