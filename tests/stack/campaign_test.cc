@@ -307,12 +307,12 @@ ClosedLoopSummary RunFromStart(const CampaignSpec& spec, long index, const Vecto
 
 TEST(Campaign, ExactModelRandomRunsThatOnceBrokeALimitHold) {
   const CampaignSpec spec = MakeCampaignSpec(DefaultConfigPath(), "random", "", 1, 0.0);
+  Vector6d pose_59, velocity_59;
+  pose_59 << 0.10047874906307575, 0.083726760217120361, 0.46541845547404032, 0.064566053172701268,
+      0.00037344108612659356, 0.045602607721660464;
+  velocity_59 << -0.0042426381779905589, 0.00014597704659844278, -0.00025369932825717147, 0.0, 0.0,
+      0.0;
   for (const int index : {6, 23, 24, 53, 59, 72, 95, 123, 127, 129, 138}) {
-    Vector6d pose_59, velocity_59;
-    pose_59 << 0.10047874906307575, 0.083726760217120361, 0.46541845547404032, 0.064566053172701268,
-        0.00037344108612659356, 0.045602607721660464;
-    velocity_59 << -0.0042426381779905589, 0.00014597704659844278, -0.00025369932825717147, 0.0,
-        0.0, 0.0;
     const ClosedLoopSummary s = index == 59 ? RunFromStart(spec, index, pose_59, velocity_59)
                                             : RunCampaignRow(spec, index, nullptr).summary;
     EXPECT_TRUE(s.completed) << "run " << index << ": " << s.failure;
