@@ -12,6 +12,7 @@
 #include <string>
 
 #include "stewart/config/config_loader.h"
+#include "stewart/config/default_config.h"
 #include "stewart/safety/constraint_set.h"
 #include "stewart/stack/campaign_summary.h"
 #include "stewart/stack/random_scenario.h"
@@ -100,10 +101,7 @@ struct P16pConfigFile {
   std::string path =
       testing::TempDir() + "/campaign_test_p16p_" + std::to_string(::getpid()) + ".yaml";
   P16pConfigFile() {
-    YAML::Emitter merged;
-    merged << LoadMergedConfigYaml(
-        DefaultConfigPath(), {std::string(STEWART_SOURCE_DIR) + "/config/overlays/p16p.yaml"});
-    std::ofstream(path) << merged.c_str();
+    std::ofstream(path) << LoadMergedConfigYaml(DefaultConfigPath(), {DcMotorOverlayPath()});
   }
   ~P16pConfigFile() { std::remove(path.c_str()); }
 };
